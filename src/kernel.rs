@@ -1,0 +1,155 @@
+//! The cubic B-spline SPH kernel (Monaghan's M4 spline written over its support radius H),
+//! ALGORITHM.md §2.1.
+
+use crate::Vec3;
+use std::f64::consts::PI;
+
+/// Distances at or below this length (metres) have a zero kernel gradient, so coincident
+/// particles never produce a NaN direction.
+const GRADIENT_CUTOFF: f64 = 1e-9;
+
+/// The 3D cubic spline kernel W(r) with support radius H (W = 0 for |r| > H).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CubicKernel {
+    support_radius: f64,
+    /// Normalisation σ = 8/(πH³), in 1/m³; also W(0).
+    sigma: f64,
+    /// 48/(πH⁴), the gradient's prefactor, in 1/m⁴.
+    gradient_factor: f64,
+}
+
+impl CubicKernel {
+    /// A kernel with support radius `support_radius` (H, metres; must be positive).
+    pub fn new(support_radius: f64) -> Self {
+        let h3 = support_radius.powi(3);
+        Self {
+            support_radius,
+            sigma: 8.0 / (PI * h3),
+            gradient_factor: 48.0 / (PI * h3 * support_radius),
+        }
+    }
+
+    /// The support radius H in metres.
+    pub fn support_radius(&self) -> f64 {
+        self.support_radius
+    }
+
+    /// W(0) = σ, in 1/m³.
+    pub fn w_zero(&self) -> f64 {
+        self.sigma
+    }
+
+    /// W at distance `r` (metres), in 1/m³.
+    #[inline]
+    pub fn w(&self, r: f64) -> f64 {
+        let q = r / self.support_radius;
+        if q <= 0.5 {
+            self.sigma * (6.0 * q * q * (q - 1.0) + 1.0)
+        } else if q <= 1.0 {
+            let t = 1.0 - q;
+            self.sigma * 2.0 * t * t * t
+        } else {
+            0.0
+        }
+    }
+
+    /// ∇W with respect to the first argument of W(x_i − x_j), given `r = x_i − x_j` (metres),
+    /// in 1/m⁴.
+    #[inline]
+    pub fn grad_w(&self, r: &Vec3) -> Vec3 {
+        let len = r.norm();
+        let q = len / self.support_radius;
+        if len <= GRADIENT_CUTOFF || q > 1.0 {
+            return Vec3::zeros();
+        }
+        let shape = if q <= 0.5 {
+            q * (3.0 * q - 2.0)
+        } else {
+            let t = 1.0 - q;
+            -t * t
+        };
+        r * (self.gradient_factor * shape / len)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn integrates_to_one() {
+        let h = 0.1;
+        let kernel = CubicKernel::new(h);
+        // Radial integral ∫ 4π r² W(r) dr by the composite Simpson rule.
+        let n = 2000;
+        let dr = h / n as f64;
+        let f = |r: f64| 4.0 * PI * r * r * kernel.w(r);
+        let mut sum = f(0.0) + f(h);
+        for i in 1..n {
+            sum += f(i as f64 * dr) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        let integral = sum * dr / 3.0;
+        assert!((integral - 1.0).abs() < 1e-6, "integral {integral}");
+    }
+
+    #[test]
+    fn lattice_sum_is_one() {
+        // Σ_j W(x_i − x_j) d³ over a cubic lattice of spacing d = H/2 (ALGORITHM.md §2.2: 0.99997).
+        let h = 0.1;
+        let d = h / 2.0;
+        let kernel = CubicKernel::new(h);
+        let mut sum = 0.0;
+        for i in -3..=3 {
+            for j in -3..=3 {
+                for k in -3..=3 {
+                    let r = Vec3::new(i as f64, j as f64, k as f64) * d;
+                    sum += kernel.w(r.norm());
+                }
+            }
+        }
+        assert!(
+            (sum * d * d * d - 0.99997).abs() < 5e-5,
+            "{}",
+            sum * d * d * d
+        );
+    }
+
+    #[test]
+    fn value_at_zero_and_support() {
+        let kernel = CubicKernel::new(0.1);
+        assert_eq!(kernel.w(0.0), 8.0 / (PI * 1e-3));
+        assert_eq!(kernel.w_zero(), kernel.w(0.0));
+        assert_eq!(kernel.w(0.1), 0.0);
+        assert_eq!(kernel.w(0.1000001), 0.0);
+        // Continuous at q = 1/2: both branches give σ/4.
+        assert!((kernel.w(0.05) - kernel.w_zero() / 4.0).abs() < 1e-9);
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences() {
+        let kernel = CubicKernel::new(0.1);
+        let eps = 1e-7;
+        for r in [
+            Vec3::new(0.01, 0.002, -0.003),
+            Vec3::new(0.03, -0.02, 0.01),
+            Vec3::new(-0.06, 0.04, 0.02),
+            Vec3::new(0.0, 0.0, 0.09),
+        ] {
+            let g = kernel.grad_w(&r);
+            for axis in 0..3 {
+                let mut plus = r;
+                let mut minus = r;
+                plus[axis] += eps;
+                minus[axis] -= eps;
+                let fd = (kernel.w(plus.norm()) - kernel.w(minus.norm())) / (2.0 * eps);
+                assert!(
+                    (fd - g[axis]).abs() <= 1e-5 * g.norm().max(1.0),
+                    "axis {axis} r {r:?}: fd {fd} analytic {}",
+                    g[axis]
+                );
+            }
+        }
+        assert_eq!(kernel.grad_w(&Vec3::zeros()), Vec3::zeros());
+        assert_eq!(kernel.grad_w(&Vec3::new(0.2, 0.0, 0.0)), Vec3::zeros());
+    }
+}

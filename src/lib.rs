@@ -1,0 +1,44 @@
+//! projfluid: liquids as SPH particles simulated with Projective Dynamics (Weiler et al. 2016),
+//! accelerated with Chebyshev's semi-iterative method (Sommer et al. 2020).
+//!
+//! A [`World`] holds fluid and boundary particles and advances them in time:
+//!
+//! ```
+//! use projfluid::{Params, World, Vec3, boundary::Aabb};
+//! let mut world = World::new(Params::default()).unwrap();
+//! world.add_container(Aabb { min: Vec3::zeros(), max: Vec3::new(0.6, 0.6, 0.6) }, 1).unwrap();
+//! world.add_fluid_block(Vec3::repeat(0.05), [4, 4, 4], Vec3::zeros()).unwrap();
+//! world.advance(0.01).unwrap();
+//! assert_eq!(world.escaped_count(), 0);
+//! ```
+//!
+//! Units are SI throughout: metres, seconds, kilograms.
+
+pub mod boundary;
+pub mod constraint;
+mod error;
+pub mod ffi;
+pub mod io;
+pub mod kernel;
+pub mod neighbors;
+pub mod params;
+pub mod reduce;
+pub mod scene;
+pub mod solver;
+pub mod stats;
+mod step;
+mod world;
+
+pub use error::Error;
+pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+pub use world::World;
+
+/// A 3-vector of f64 (metres, metres per second, …).
+pub type Vec3 = nalgebra::Vector3<f64>;
+
+impl World {
+    /// Worker threads of the world's pool.
+    pub fn thread_count(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+}

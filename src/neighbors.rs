@@ -1,0 +1,433 @@
+//! Neighbour search on a uniform grid (ALGORITHM.md §6): cells of edge H, a counting sort of the
+//! particles by cell in Z-order (Morton order), and compressed (CSR) neighbour lists built in
+//! parallel. Every output depends only on the input positions, never on the thread count.
+
+use crate::Vec3;
+use rayon::prelude::*;
+
+/// Queries handled per parallel task; fixed so results never depend on the thread count.
+const BLOCK: usize = 256;
+/// Largest number of cells a grid may have; beyond it the grid stops growing and particles
+/// outside are clamped into its border cells (still correct, only slower).
+const MAX_CELLS: usize = 1 << 22;
+
+/// A uniform grid over an axis-aligned domain. Points outside the domain are clamped into
+/// the border cells, which keeps every pair closer than the cell size in adjacent cells.
+#[derive(Clone, Debug)]
+pub struct UniformGrid {
+    origin: Vec3,
+    cell_size: f64,
+    dims: [usize; 3],
+    /// Z-order rank of each cell, indexed by its linear (x-fastest) index.
+    z_rank: Vec<u32>,
+}
+
+impl UniformGrid {
+    /// A grid of cells of edge `cell_size` (metres) covering `[min, max]` plus one cell of margin
+    /// on every side. The cell count is capped; an oversized domain gets a clamped grid.
+    pub fn covering(min: Vec3, max: Vec3, cell_size: f64) -> Self {
+        let origin = min - Vec3::repeat(cell_size);
+        let mut dims = [0usize; 3];
+        for axis in 0..3 {
+            let extent = (max[axis] - min[axis]).max(0.0) + 2.0 * cell_size;
+            dims[axis] = ((extent / cell_size).floor() as usize + 1).clamp(1, 1 << 20);
+        }
+        while dims.iter().product::<usize>() > MAX_CELLS {
+            let largest = (0..3).max_by_key(|&a| dims[a]).unwrap_or(0);
+            dims[largest] = dims[largest].div_ceil(2);
+        }
+        let count = dims.iter().product::<usize>();
+        let mut by_morton: Vec<(u64, u32)> = (0..count)
+            .map(|linear| {
+                let x = linear % dims[0];
+                let y = (linear / dims[0]) % dims[1];
+                let z = linear / (dims[0] * dims[1]);
+                (morton_code(x as u32, y as u32, z as u32), linear as u32)
+            })
+            .collect();
+        by_morton.sort_unstable();
+        let mut z_rank = vec![0u32; count];
+        for (rank, &(_, linear)) in by_morton.iter().enumerate() {
+            z_rank[linear as usize] = rank as u32;
+        }
+        Self {
+            origin,
+            cell_size,
+            dims,
+            z_rank,
+        }
+    }
+
+    /// Number of cells.
+    pub fn cell_count(&self) -> usize {
+        self.z_rank.len()
+    }
+
+    /// Cell edge length in metres.
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// True when every point lies inside the grid's domain, i.e. no point needs clamping.
+    pub fn covers(&self, points: &[Vec3]) -> bool {
+        let (lo, hi) = (self.origin, self.upper_corner());
+        points
+            .par_iter()
+            .all(|p| (0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a]))
+    }
+
+    fn upper_corner(&self) -> Vec3 {
+        self.origin
+            + Vec3::new(
+                self.dims[0] as f64,
+                self.dims[1] as f64,
+                self.dims[2] as f64,
+            ) * self.cell_size
+    }
+
+    /// Integer cell coordinates of `p`, clamped into the grid.
+    #[inline]
+    fn cell_of(&self, p: &Vec3) -> [usize; 3] {
+        let mut c = [0usize; 3];
+        for axis in 0..3 {
+            let f = ((p[axis] - self.origin[axis]) / self.cell_size).floor();
+            // NaN maps to cell 0; `as` saturates, the clamp keeps it in range.
+            c[axis] = (f.max(0.0) as usize).min(self.dims[axis] - 1);
+        }
+        c
+    }
+
+    #[inline]
+    fn rank(&self, c: [usize; 3]) -> usize {
+        self.z_rank[c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])] as usize
+    }
+
+    /// Counting sort of `points` by cell in Z-order. Writes `order` (sorted slot → input index,
+    /// stable) and the table of cell ranges.
+    pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) {
+        let ranks = &mut table.ranks;
+        ranks.resize(points.len(), 0);
+        ranks
+            .par_iter_mut()
+            .zip(points.par_iter())
+            .for_each(|(r, p)| *r = self.rank(self.cell_of(p)) as u32);
+        let starts = &mut table.cell_start;
+        starts.clear();
+        starts.resize(self.cell_count() + 1, 0);
+        for &r in ranks.iter() {
+            starts[r as usize + 1] += 1;
+        }
+        for c in 0..self.cell_count() {
+            starts[c + 1] += starts[c];
+        }
+        order.clear();
+        order.resize(points.len(), 0);
+        let mut cursor = starts[..self.cell_count()].to_vec();
+        for (i, &r) in ranks.iter().enumerate() {
+            let slot = &mut cursor[r as usize];
+            order[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+    }
+
+    /// For every query point, the indices of `points` (already in the order of `table`) within
+    /// `radius` (≤ cell size), sorted ascending. With `exclude_self`, query i skips point i.
+    pub fn search(
+        &self,
+        table: &CellTable,
+        points: &[Vec3],
+        queries: &[Vec3],
+        radius: f64,
+        exclude_self: bool,
+        out: &mut NeighborLists,
+    ) {
+        assert!(
+            radius <= self.cell_size,
+            "search radius exceeds the cell size"
+        );
+        let r2 = radius * radius;
+        let blocks = queries.len().div_ceil(BLOCK);
+        out.scratch.resize_with(blocks, Default::default);
+        out.scratch
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(b, (counts, found))| {
+                counts.clear();
+                found.clear();
+                for i in b * BLOCK..((b + 1) * BLOCK).min(queries.len()) {
+                    let q = queries[i];
+                    let start = found.len();
+                    let c = self.cell_of(&q);
+                    for z in c[2].saturating_sub(1)..=(c[2] + 1).min(self.dims[2] - 1) {
+                        for y in c[1].saturating_sub(1)..=(c[1] + 1).min(self.dims[1] - 1) {
+                            for x in c[0].saturating_sub(1)..=(c[0] + 1).min(self.dims[0] - 1) {
+                                let rank = self.rank([x, y, z]);
+                                let range = table.cell_start[rank]..table.cell_start[rank + 1];
+                                for j in range {
+                                    if exclude_self && j as usize == i {
+                                        continue;
+                                    }
+                                    if (points[j as usize] - q).norm_squared() <= r2 {
+                                        found.push(j);
+                                    }
+                                }
+                            }
+                        }
+                    }
+                    found[start..].sort_unstable();
+                    counts.push((found.len() - start) as u32);
+                }
+            });
+        out.offsets.clear();
+        out.offsets.push(0);
+        let mut total = 0u32;
+        for (counts, _) in &out.scratch {
+            for &n in counts {
+                total += n;
+                out.offsets.push(total);
+            }
+        }
+        out.indices.resize(total as usize, 0);
+        let mut rest = out.indices.as_mut_slice();
+        let mut pieces = Vec::with_capacity(blocks);
+        for (_, found) in &out.scratch {
+            let (head, tail) = rest.split_at_mut(found.len());
+            pieces.push((head, found));
+            rest = tail;
+        }
+        pieces
+            .into_par_iter()
+            .for_each(|(dst, src)| dst.copy_from_slice(src));
+    }
+}
+
+/// Cell ranges produced by [`UniformGrid::sort`]: the points of the cell with Z-rank `c` are
+/// the sorted slots `cell_start[c]..cell_start[c + 1]`.
+#[derive(Clone, Debug, Default)]
+pub struct CellTable {
+    cell_start: Vec<u32>,
+    ranks: Vec<u32>,
+}
+
+/// Neighbour lists in compressed form: the neighbours of query i are
+/// `indices[offsets[i]..offsets[i + 1]]`, ascending.
+#[derive(Clone, Debug, Default)]
+pub struct NeighborLists {
+    /// Start of each query's list in `indices`; one more entry than queries.
+    pub offsets: Vec<u32>,
+    /// Neighbour indices, concatenated.
+    pub indices: Vec<u32>,
+    scratch: Vec<(Vec<u32>, Vec<u32>)>,
+}
+
+impl NeighborLists {
+    /// The neighbours of query `i`.
+    #[inline]
+    pub fn of(&self, i: usize) -> &[u32] {
+        &self.indices[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+    }
+
+    /// The number of neighbours of query `i`.
+    #[inline]
+    pub fn count(&self, i: usize) -> usize {
+        (self.offsets[i + 1] - self.offsets[i]) as usize
+    }
+
+    /// Number of queries.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// True when there are no queries.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// For symmetric lists (i lists j exactly when j lists i): for every pair slot k of query
+    /// i pointing to j, the slot of i inside j's list.
+    pub fn reverse_slots(&self, reverse: &mut Vec<u32>) {
+        reverse.resize(self.indices.len(), 0);
+        par_segments_mut(&self.offsets, reverse, |i, slots| {
+            for (slot, &j) in slots.iter_mut().zip(self.of(i)) {
+                let theirs = self.of(j as usize);
+                let at = theirs
+                    .binary_search(&(i as u32))
+                    .expect("neighbour lists are symmetric");
+                *slot = self.offsets[j as usize] + at as u32;
+            }
+        });
+    }
+}
+
+/// Runs `f(i, segment_i)` in parallel over the CSR segments `data[offsets[i]..offsets[i + 1]]`.
+pub fn par_segments_mut<T: Send>(
+    offsets: &[u32],
+    data: &mut [T],
+    f: impl Fn(usize, &mut [T]) + Sync,
+) {
+    let n = offsets.len().saturating_sub(1);
+    let mut pieces = Vec::with_capacity(n.div_ceil(BLOCK));
+    let mut rest = data;
+    for b in 0..n.div_ceil(BLOCK) {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+        let (head, tail) = rest.split_at_mut((offsets[hi] - offsets[lo]) as usize);
+        pieces.push((lo, hi, head));
+        rest = tail;
+    }
+    pieces.into_par_iter().for_each(|(lo, hi, chunk)| {
+        let base = offsets[lo] as usize;
+        for i in lo..hi {
+            let (a, b) = (offsets[i] as usize - base, offsets[i + 1] as usize - base);
+            f(i, &mut chunk[a..b]);
+        }
+    });
+}
+
+/// Interleaves the low 21 bits of x, y, z into a 63-bit Morton code.
+fn morton_code(x: u32, y: u32, z: u32) -> u64 {
+    fn spread(v: u32) -> u64 {
+        let mut v = v as u64 & 0x1f_ffff;
+        v = (v | v << 32) & 0x1f_0000_0000_ffff;
+        v = (v | v << 16) & 0x1f_0000_ff00_00ff;
+        v = (v | v << 8) & 0x100f_00f0_0f00_f00f;
+        v = (v | v << 4) & 0x10c3_0c30_c30c_30c3;
+        v = (v | v << 2) & 0x1249_2492_4924_9249;
+        v
+    }
+    spread(x) | spread(y) << 1 | spread(z) << 2
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn random_points(n: usize, seed: u64, extent: f64) -> Vec<Vec3> {
+        let mut state = seed;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        (0..n)
+            .map(|_| Vec3::new(next(), next(), next()) * extent)
+            .collect()
+    }
+
+    fn sorted_copy(grid: &UniformGrid, pts: &[Vec3], table: &mut CellTable) -> Vec<Vec3> {
+        let mut order = Vec::new();
+        grid.sort(pts, &mut order, table);
+        order.iter().map(|&i| pts[i as usize]).collect()
+    }
+
+    #[test]
+    fn morton_interleaves_bits() {
+        assert_eq!(morton_code(1, 0, 0), 1);
+        assert_eq!(morton_code(0, 1, 0), 2);
+        assert_eq!(morton_code(0, 0, 1), 4);
+        assert_eq!(morton_code(3, 3, 3), 63);
+        assert_eq!(morton_code(0x1f_ffff, 0, 0), 0x1249_2492_4924_9249);
+    }
+
+    #[test]
+    fn sort_is_a_stable_permutation_in_z_order() {
+        let pts = random_points(3000, 7, 1.0);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let mut table = CellTable::default();
+        let mut order = Vec::new();
+        grid.sort(&pts, &mut order, &mut table);
+        let mut seen = order.clone();
+        seen.sort_unstable();
+        assert!(seen.iter().enumerate().all(|(i, &v)| i as u32 == v));
+        let ranks: Vec<usize> = order
+            .iter()
+            .map(|&i| grid.rank(grid.cell_of(&pts[i as usize])))
+            .collect();
+        for w in 0..order.len() - 1 {
+            assert!(
+                ranks[w] < ranks[w + 1] || (ranks[w] == ranks[w + 1] && order[w] < order[w + 1])
+            );
+        }
+    }
+
+    #[test]
+    fn search_equals_brute_force() {
+        let radius = 0.1;
+        // Some points deliberately outside the grid's domain to exercise clamping.
+        let mut pts = random_points(4000, 42, 1.0);
+        pts.extend(
+            random_points(200, 9, 3.0)
+                .into_iter()
+                .map(|p| p - Vec3::repeat(1.0)),
+        );
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &pts, &mut table);
+        let mut lists = NeighborLists::default();
+        grid.search(&table, &sorted, &sorted, radius, true, &mut lists);
+        assert_eq!(lists.len(), sorted.len());
+        let mut total = 0;
+        for (i, p) in sorted.iter().enumerate() {
+            let brute: Vec<u32> = (0..sorted.len() as u32)
+                .filter(|&j| j as usize != i && (sorted[j as usize] - p).norm() <= radius)
+                .collect();
+            assert_eq!(lists.of(i), brute.as_slice(), "query {i}");
+            total += brute.len();
+        }
+        assert!(
+            total > 10_000,
+            "test should exercise many pairs, got {total}"
+        );
+
+        // Queries against a second point set (as for boundary particles).
+        let others = random_points(1500, 3, 1.0);
+        let sorted_others = sorted_copy(&grid, &others, &mut table);
+        grid.search(&table, &sorted_others, &sorted, radius, false, &mut lists);
+        for (i, p) in sorted.iter().enumerate() {
+            let brute: Vec<u32> = (0..sorted_others.len() as u32)
+                .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
+                .collect();
+            assert_eq!(lists.of(i), brute.as_slice());
+        }
+    }
+
+    #[test]
+    fn reverse_slots_point_back() {
+        let pts = random_points(2000, 5, 0.8);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(0.8), 0.1);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &pts, &mut table);
+        let mut lists = NeighborLists::default();
+        grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
+        let mut reverse = Vec::new();
+        lists.reverse_slots(&mut reverse);
+        for i in 0..lists.len() {
+            for (k, &j) in lists.of(i).iter().enumerate() {
+                let back = reverse[lists.offsets[i] as usize + k] as usize;
+                assert_eq!(lists.indices[back] as usize, i);
+                assert!(back >= lists.offsets[j as usize] as usize);
+                assert!(back < lists.offsets[j as usize + 1] as usize);
+            }
+        }
+    }
+
+    #[test]
+    fn results_do_not_depend_on_thread_count() {
+        let pts = random_points(5000, 11, 1.0);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut table = CellTable::default();
+                let sorted = sorted_copy(&grid, &pts, &mut table);
+                let mut lists = NeighborLists::default();
+                grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
+                (lists.offsets, lists.indices)
+            })
+        };
+        assert_eq!(run(1), run(3));
+    }
+}

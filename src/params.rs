@@ -1,0 +1,274 @@
+//! Simulation parameters with their defaults (ALGORITHM.md Appendix A) and validation.
+
+use crate::Error;
+
+/// Which global solver runs in each outer iteration (ALGORITHM.md §3).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum SolverKind {
+    /// One Jacobi sweep plus Chebyshev extrapolation over the outer iterations (§3.7).
+    Chebyshev,
+    /// Exactly one Jacobi sweep per outer iteration (exact for the diagonal formulation F1).
+    Jacobi1,
+    /// Jacobi sweeps until ‖b − Ax‖ ≤ 1e-10‖b‖ or 100 sweeps.
+    Jacobi,
+}
+
+impl SolverKind {
+    /// Every solver, in the order the CLI lists them.
+    pub const ALL: [SolverKind; 3] = [
+        SolverKind::Chebyshev,
+        SolverKind::Jacobi1,
+        SolverKind::Jacobi,
+    ];
+
+    /// The solver's name as used by the CLI, scenes and statistics.
+    pub fn name(self) -> &'static str {
+        match self {
+            SolverKind::Chebyshev => "chebyshev",
+            SolverKind::Jacobi1 => "jacobi1",
+            SolverKind::Jacobi => "jacobi",
+        }
+    }
+
+    /// Parses a solver name (see [`SolverKind::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// How ω₂, the first Chebyshev weight, is chosen (ALGORITHM.md §3.7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Omega2Rule {
+    /// ω₂ = 2/(2 − ρ²), the Chebyshev-polynomial start (Wang 2015).
+    Chebyshev,
+    /// ω₂ = 4/(4 − ρ²), the seed paper's text read literally.
+    SeedLiteral,
+}
+
+impl Omega2Rule {
+    /// The rule's name in scenes and on the command line.
+    pub fn name(self) -> &'static str {
+        match self {
+            Omega2Rule::Chebyshev => "chebyshev",
+            Omega2Rule::SeedLiteral => "seed",
+        }
+    }
+
+    /// Parses a rule name (see [`Omega2Rule::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Omega2Rule::Chebyshev, Omega2Rule::SeedLiteral]
+            .into_iter()
+            .find(|r| r.name() == name)
+    }
+}
+
+/// Weight w_j applied to a particle's share of a local projection (ALGORITHM.md §2.5).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ProjectionWeight {
+    /// w_j = n_j + 1, the fluid neighbour count plus one (the reference behaviour).
+    NeighborCount,
+    /// w_j = 1, a true projection.
+    Unit,
+}
+
+/// Settings of Chebyshev's semi-iterative acceleration (ALGORITHM.md §3.7).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ChebyshevParams {
+    /// Estimated spectral radius ρ_c of the outer iteration, in [0, 1).
+    pub rho: f64,
+    /// Delay S ≥ 1: outer iterations with ω = 1 before extrapolation starts.
+    pub delay: usize,
+    /// Rule for the first weight ω₂.
+    pub omega2_rule: Omega2Rule,
+    /// Under-relaxation γ in (0, 1].
+    pub gamma: f64,
+}
+
+/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
+pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.9;
+/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
+pub const DEFAULT_CHEBYSHEV_DELAY: usize = 3;
+
+impl Default for ChebyshevParams {
+    fn default() -> Self {
+        Self {
+            rho: DEFAULT_CHEBYSHEV_RHO,
+            delay: DEFAULT_CHEBYSHEV_DELAY,
+            omega2_rule: Omega2Rule::Chebyshev,
+            gamma: 1.0,
+        }
+    }
+}
+
+/// Every setting of a world. Lengths in metres, times in seconds, densities in kg/m³.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Params {
+    /// Particle radius r (m); the lattice spacing is 2r and the support radius H = 4r.
+    pub particle_radius: f64,
+    /// Rest density ρ0 (kg/m³).
+    pub rest_density: f64,
+    /// Particle mass as a fraction of ρ0·(2r)³ (0.8 in the reference implementation).
+    pub mass_factor: f64,
+    /// Constraint stiffness k (N/m).
+    pub stiffness: f64,
+    /// Gravitational acceleration (m/s²).
+    pub gravity: [f64; 3],
+    /// The global solver.
+    pub solver: SolverKind,
+    /// Chebyshev settings (used by [`SolverKind::Chebyshev`]).
+    pub chebyshev: ChebyshevParams,
+    /// Outer stopping threshold τ (m): stop when no particle moved more than τ in an iteration.
+    pub displacement_tolerance: f64,
+    /// Smallest number of outer iterations per step (≥ 1).
+    pub min_outer_iterations: usize,
+    /// Largest number of outer iterations per step.
+    pub max_outer_iterations: usize,
+    /// Weighting of the local projection.
+    pub projection_weight: ProjectionWeight,
+    /// CFL factor λ in Δt = λ·0.4·2r/v_max.
+    pub cfl_factor: f64,
+    /// Smallest time step (s).
+    pub dt_min: f64,
+    /// Largest time step (s).
+    pub dt_max: f64,
+    /// Time step of the first step (s).
+    pub dt_initial: f64,
+    /// XSPH viscosity coefficient c_X (dimensionless, 0 = off).
+    pub viscosity: f64,
+    /// Worker threads of the world's own pool (0 = one per core).
+    pub threads: usize,
+}
+
+/// Default particle radius (m).
+pub const DEFAULT_PARTICLE_RADIUS: f64 = 0.025;
+/// Default τ as a multiple of the particle radius (ALGORITHM.md §4).
+pub const DEFAULT_TOLERANCE_PER_RADIUS: f64 = 1e-3;
+
+impl Default for Params {
+    fn default() -> Self {
+        Self::with_radius(DEFAULT_PARTICLE_RADIUS)
+    }
+}
+
+impl Params {
+    /// Default parameters for particle radius `r` (m), with τ = 1e-3·r.
+    pub fn with_radius(r: f64) -> Self {
+        Self {
+            particle_radius: r,
+            rest_density: 1000.0,
+            mass_factor: 0.8,
+            stiffness: 5e4,
+            gravity: [0.0, -9.81, 0.0],
+            solver: SolverKind::Chebyshev,
+            chebyshev: ChebyshevParams::default(),
+            displacement_tolerance: DEFAULT_TOLERANCE_PER_RADIUS * r,
+            min_outer_iterations: 1,
+            max_outer_iterations: 100,
+            projection_weight: ProjectionWeight::NeighborCount,
+            cfl_factor: 0.5,
+            dt_min: 1e-4,
+            dt_max: 5e-3,
+            dt_initial: 1e-3,
+            viscosity: 0.01,
+            threads: 0,
+        }
+    }
+
+    /// Lattice spacing d = 2r (m).
+    pub fn spacing(&self) -> f64 {
+        2.0 * self.particle_radius
+    }
+
+    /// Support radius H = 4r (m).
+    pub fn support_radius(&self) -> f64 {
+        4.0 * self.particle_radius
+    }
+
+    /// Fluid particle mass m = mass_factor·ρ0·(2r)³ (kg).
+    pub fn particle_mass(&self) -> f64 {
+        self.mass_factor * self.rest_density * self.spacing().powi(3)
+    }
+
+    /// Checks every field; the error names the first bad field and its value.
+    pub fn validate(&self) -> Result<(), Error> {
+        let positive = [
+            ("particle_radius", self.particle_radius),
+            ("rest_density", self.rest_density),
+            ("mass_factor", self.mass_factor),
+            ("stiffness", self.stiffness),
+            ("displacement_tolerance", self.displacement_tolerance),
+            ("cfl_factor", self.cfl_factor),
+            ("dt_min", self.dt_min),
+            ("dt_max", self.dt_max),
+            ("dt_initial", self.dt_initial),
+        ];
+        for (name, value) in positive {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(Error::invalid(
+                    name,
+                    value,
+                    "must be a positive finite number",
+                ));
+            }
+        }
+        for (axis, g) in self.gravity.iter().enumerate() {
+            if !g.is_finite() {
+                return Err(Error::invalid(
+                    format!("gravity[{axis}]"),
+                    g,
+                    "must be finite",
+                ));
+            }
+        }
+        if self.dt_min > self.dt_max {
+            return Err(Error::invalid(
+                "dt_min",
+                self.dt_min,
+                "must not exceed dt_max",
+            ));
+        }
+        if !(self.viscosity.is_finite() && (0.0..=1.0).contains(&self.viscosity)) {
+            return Err(Error::invalid(
+                "viscosity",
+                self.viscosity,
+                "must lie in [0, 1]",
+            ));
+        }
+        let c = &self.chebyshev;
+        if !(c.rho.is_finite() && (0.0..1.0).contains(&c.rho)) {
+            return Err(Error::invalid("rho", c.rho, "must lie in [0, 1)"));
+        }
+        if c.delay < 1 {
+            return Err(Error::invalid("delay", c.delay, "must be at least 1"));
+        }
+        if !(c.gamma.is_finite() && c.gamma > 0.0 && c.gamma <= 1.0) {
+            return Err(Error::invalid("gamma", c.gamma, "must lie in (0, 1]"));
+        }
+        if self.min_outer_iterations < 1 {
+            let n = self.min_outer_iterations;
+            return Err(Error::invalid(
+                "min_outer_iterations",
+                n,
+                "must be at least 1",
+            ));
+        }
+        if self.max_outer_iterations < self.min_outer_iterations
+            || self.max_outer_iterations > 100_000
+        {
+            let n = self.max_outer_iterations;
+            return Err(Error::invalid(
+                "max_outer_iterations",
+                n,
+                "must lie between min_outer_iterations and 100000",
+            ));
+        }
+        if self.threads > 1024 {
+            return Err(Error::invalid(
+                "threads",
+                self.threads,
+                "must be at most 1024",
+            ));
+        }
+        Ok(())
+    }
+}

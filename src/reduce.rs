@@ -1,0 +1,51 @@
+//! Parallel reductions whose result does not depend on the thread count: work is split into
+//! fixed-size chunks and the chunk results are combined in order.
+
+use rayon::prelude::*;
+
+/// Elements per chunk; fixed so the summation order never depends on the thread count.
+const CHUNK: usize = 4096;
+
+/// Σ f(x) over `items`, bitwise identical for any thread count.
+pub fn sum<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync) -> f64 {
+    let partial: Vec<f64> = items
+        .par_chunks(CHUNK)
+        .map(|chunk| chunk.iter().map(&f).sum())
+        .collect();
+    partial.iter().sum()
+}
+
+/// max f(x) over `items` (−∞ for none); NaN values propagate as NaN.
+pub fn max<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync + Send) -> f64 {
+    items.par_iter().map(f).reduce(
+        || f64::NEG_INFINITY,
+        |a, b| {
+            if a.is_nan() || b.is_nan() {
+                f64::NAN
+            } else {
+                a.max(b)
+            }
+        },
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn sum_is_independent_of_thread_count() {
+        let values: Vec<f64> = (0..100_000)
+            .map(|i| ((i * 7919) % 1000) as f64 * 0.1 + 1e-9)
+            .collect();
+        let run = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| super::sum(&values, |v| *v))
+        };
+        assert_eq!(run(1).to_bits(), run(4).to_bits());
+        assert!((run(1) - values.iter().sum::<f64>()).abs() < 1e-6);
+        assert!(super::max(&[1.0, f64::NAN, 3.0], |v| *v).is_nan());
+        assert_eq!(super::max(&[1.0, 5.0, 3.0], |v| *v), 5.0);
+    }
+}

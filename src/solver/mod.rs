@@ -1,0 +1,141 @@
+//! The global step of the local/global iteration (ALGORITHM.md §3): the system matrix and the
+//! linear solvers behind one trait, plus Chebyshev's extrapolation over the outer iterations.
+
+mod chebyshev;
+mod jacobi;
+
+pub use chebyshev::Chebyshev;
+pub use jacobi::Jacobi;
+
+use crate::Vec3;
+use crate::params::SolverKind;
+use rayon::prelude::*;
+
+/// The matrix A of the global step, A = Â ⊗ I₃, seen by the solvers only through its action
+/// and its diagonal, so that formulations other than the diagonal one can be added.
+pub trait SystemMatrix: Sync {
+    /// out = A·x.
+    fn apply(&self, x: &[Vec3], out: &mut [Vec3]);
+    /// The diagonal of Â (kg).
+    fn diagonal(&self) -> &[f64];
+}
+
+/// Formulation F1 (ALGORITHM.md §3.1): Â = diag(m + Δt²k(n_j + 1)), in kg.
+#[derive(Clone, Debug, Default)]
+pub struct DiagonalSystem {
+    /// Â_jj (kg).
+    pub diagonal: Vec<f64>,
+}
+
+impl SystemMatrix for DiagonalSystem {
+    fn apply(&self, x: &[Vec3], out: &mut [Vec3]) {
+        out.par_iter_mut()
+            .zip(x.par_iter().zip(self.diagonal.par_iter()))
+            .for_each(|(o, (x, d))| *o = x * *d);
+    }
+
+    fn diagonal(&self) -> &[f64] {
+        &self.diagonal
+    }
+}
+
+/// A linear solver for A·x = b (three right-hand sides at once).
+pub trait GlobalSolver: Send + Sync {
+    /// Called once per time step, after A changed and before the first solve.
+    fn prepare(&mut self, _matrix: &dyn SystemMatrix) {}
+    /// Solves A·x = b with `x` holding the warm start; returns the inner iterations used.
+    fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize;
+}
+
+/// Relative residual ‖b − Ax‖ ≤ this·‖b‖ ends the converging solvers (ALGORITHM.md §3.4).
+pub const RESIDUAL_TOLERANCE: f64 = 1e-10;
+/// The converging solvers stop after this many inner iterations.
+pub const MAX_INNER_ITERATIONS: usize = 100;
+
+/// The linear solver behind a [`SolverKind`].
+pub fn linear_solver(kind: SolverKind) -> Box<dyn GlobalSolver> {
+    match kind {
+        SolverKind::Chebyshev | SolverKind::Jacobi1 => Box::new(Jacobi::single_sweep()),
+        SolverKind::Jacobi => Box::new(Jacobi::converged()),
+    }
+}
+
+#[cfg(test)]
+pub(crate) mod tests {
+    use super::*;
+
+    /// A small SPD test matrix Â (dense, symmetric) with its exact solve by Gaussian elimination.
+    pub struct DenseSystem {
+        pub n: usize,
+        pub a: Vec<f64>,
+        pub diag: Vec<f64>,
+    }
+
+    impl DenseSystem {
+        /// Diagonally dominant SPD matrix: 4 on the diagonal, −1 to ring neighbours.
+        pub fn ring(n: usize, diag: f64) -> Self {
+            let mut a = vec![0.0; n * n];
+            for i in 0..n {
+                a[i * n + i] = diag;
+                a[i * n + (i + 1) % n] -= 1.0;
+                a[i * n + (i + n - 1) % n] -= 1.0;
+            }
+            Self {
+                n,
+                diag: (0..n).map(|i| a[i * n + i]).collect(),
+                a,
+            }
+        }
+
+        pub fn exact(&self, b: &[Vec3]) -> Vec<Vec3> {
+            let n = self.n;
+            let mut m = self.a.clone();
+            let mut x = b.to_vec();
+            for c in 0..n {
+                for r in c + 1..n {
+                    let f = m[r * n + c] / m[c * n + c];
+                    for k in c..n {
+                        m[r * n + k] -= f * m[c * n + k];
+                    }
+                    let xc = x[c];
+                    x[r] -= xc * f;
+                }
+            }
+            for c in (0..n).rev() {
+                let mut v = x[c];
+                for k in c + 1..n {
+                    v -= x[k] * m[c * n + k];
+                }
+                x[c] = v / m[c * n + c];
+            }
+            x
+        }
+    }
+
+    impl SystemMatrix for DenseSystem {
+        fn apply(&self, x: &[Vec3], out: &mut [Vec3]) {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = (0..self.n).map(|j| x[j] * self.a[i * self.n + j]).sum();
+            }
+        }
+        fn diagonal(&self) -> &[f64] {
+            &self.diag
+        }
+    }
+
+    pub fn rhs(n: usize) -> Vec<Vec3> {
+        (0..n)
+            .map(|i| Vec3::new(i as f64, (i * i % 7) as f64 - 3.0, 1.0 / (i + 1) as f64))
+            .collect()
+    }
+
+    #[test]
+    fn diagonal_system_applies_its_diagonal() {
+        let sys = DiagonalSystem {
+            diagonal: vec![2.0, 3.0],
+        };
+        let mut out = vec![Vec3::zeros(); 2];
+        sys.apply(&[Vec3::repeat(1.0), Vec3::new(1.0, 2.0, 3.0)], &mut out);
+        assert_eq!(out, vec![Vec3::repeat(2.0), Vec3::new(3.0, 6.0, 9.0)]);
+    }
+}

@@ -1,0 +1,139 @@
+//! Per-step statistics and the run summary that the CLI prints and writes as `--stats` JSON.
+
+use crate::World;
+use serde::Serialize;
+
+/// Wall-clock seconds spent in the parts of one step.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StepTimings {
+    /// Prediction, sorting and neighbour search (s).
+    pub neighbors: f64,
+    /// Local projections (s).
+    pub local: f64,
+    /// Right-hand side, global solves and extrapolation (s).
+    pub global: f64,
+    /// Velocity update, densities, XSPH and statistics (s).
+    pub rest: f64,
+}
+
+/// What one step did.
+#[derive(Clone, Debug, PartialEq)]
+pub struct StepStats {
+    /// Step size (s).
+    pub dt: f64,
+    /// Outer (local/global) iterations.
+    pub outer_iterations: usize,
+    /// Inner iterations of the linear solver, summed over the outer iterations.
+    pub inner_iterations: usize,
+    /// The outer loop ended at its iteration limit instead of the displacement rule.
+    pub hit_max_iterations: bool,
+    /// Largest particle displacement in the last outer iteration (m).
+    pub last_displacement: f64,
+    /// Mean compression max(ρ/ρ0 − 1, 0) over fluid particles after the step (fraction).
+    pub density_error_avg: f64,
+    /// Largest compression after the step (fraction).
+    pub density_error_max: f64,
+    /// Where the time went.
+    pub timings: StepTimings,
+}
+
+/// A run's summary; field names are the stable keys of the `--stats` JSON.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct RunSummary {
+    /// Scene name.
+    pub scene: String,
+    /// Global solver name.
+    pub solver: String,
+    /// Chebyshev ρ_c (reported for every solver; used by `chebyshev` only).
+    pub rho: f64,
+    /// Outer stopping threshold τ (m).
+    pub tau: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Fluid particles.
+    pub particles: usize,
+    /// Boundary particles.
+    pub boundary_particles: usize,
+    /// Steps taken.
+    pub steps: u64,
+    /// Simulated time covered by the run (s).
+    pub sim_time: f64,
+    /// Mean wall-clock time per step (ms).
+    pub wall_ms_per_step: f64,
+    /// Mean outer iterations per step.
+    pub outer_iterations_mean: f64,
+    /// Mean over steps of the mean compression (percent).
+    pub density_error_avg_percent: f64,
+    /// Largest compression of any particle in any step (percent).
+    pub density_error_max_percent: f64,
+    /// Fluid particles outside the container at the end.
+    pub escaped: usize,
+    /// Fluid particles with a non-finite position or velocity at the end.
+    pub nan: usize,
+    /// Hex SHA-256 of the final positions' bit patterns.
+    pub positions_hash: String,
+    /// Mean milliseconds per step in neighbour search / local step / global step / rest.
+    pub ms_per_step_breakdown: [f64; 4],
+}
+
+/// Accumulates step statistics into a [`RunSummary`].
+#[derive(Clone, Debug, Default)]
+pub struct RunAccumulator {
+    steps: u64,
+    sim_time: f64,
+    wall_seconds: f64,
+    outer: u64,
+    density_avg_sum: f64,
+    density_max: f64,
+    breakdown: [f64; 4],
+}
+
+impl RunAccumulator {
+    /// Adds one step that took `wall_seconds` of wall-clock time.
+    pub fn add(&mut self, step: &StepStats, wall_seconds: f64) {
+        self.steps += 1;
+        self.sim_time += step.dt;
+        self.wall_seconds += wall_seconds;
+        self.outer += step.outer_iterations as u64;
+        self.density_avg_sum += step.density_error_avg;
+        self.density_max = self.density_max.max(step.density_error_max);
+        let t = &step.timings;
+        for (acc, v) in self
+            .breakdown
+            .iter_mut()
+            .zip([t.neighbors, t.local, t.global, t.rest])
+        {
+            *acc += v;
+        }
+    }
+
+    /// Steps added so far.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The summary of the steps added so far, with the world's final state.
+    pub fn summary(&self, scene: &str, world: &World) -> RunSummary {
+        let n = self.steps.max(1) as f64;
+        let p = world.params();
+        RunSummary {
+            scene: scene.to_string(),
+            solver: p.solver.name().to_string(),
+            rho: p.chebyshev.rho,
+            tau: p.displacement_tolerance,
+            threads: world.thread_count(),
+            particles: world.fluid_count(),
+            boundary_particles: world.boundary_count(),
+            steps: self.steps,
+            sim_time: self.sim_time,
+            wall_ms_per_step: self.wall_seconds * 1e3 / n,
+            outer_iterations_mean: self.outer as f64 / n,
+            density_error_avg_percent: self.density_avg_sum * 100.0 / n,
+            density_error_max_percent: self.density_max * 100.0,
+            escaped: world.escaped_count(),
+            nan: world.nan_count(),
+            positions_hash: world.positions_hash(),
+            ms_per_step_breakdown: self.breakdown.map(|s| s * 1e3 / n),
+        }
+    }
+}

@@ -1,0 +1,320 @@
+//! One time step (ALGORITHM.md §1.3): predict, search neighbours, iterate local projections and
+//! global solves (with Chebyshev extrapolation) until the displacement rule stops, update
+//! velocities, apply XSPH, and choose the next step size by the CFL rule (§8).
+
+use crate::constraint::Neighborhood;
+use crate::neighbors::{CellTable, NeighborLists};
+use crate::params::SolverKind;
+use crate::solver::DiagonalSystem;
+use crate::stats::{StepStats, StepTimings};
+use crate::{Error, Vec3, World, reduce};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// Buffers reused by every step, so that a step allocates nothing once sizes are stable.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct StepBuffers {
+    /// Inertial prediction s (m).
+    predicted: Vec<Vec3>,
+    /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m).
+    previous: Vec<Vec3>,
+    current: Vec<Vec3>,
+    next: Vec<Vec3>,
+    /// Right-hand side b of the global step (kg·m).
+    rhs: Vec<Vec3>,
+    /// Local-step corrections P_{i,j} − X_j, laid out by stencil (m).
+    corrections: Vec<Vec3>,
+    order: Vec<u32>,
+    table: CellTable,
+    fluid_lists: NeighborLists,
+    boundary_lists: NeighborLists,
+    /// For pair slot k of particle j (neighbour i): where i's stencil keeps its correction of j.
+    gather_slots: Vec<u32>,
+    stencil_offsets: Vec<u32>,
+    system: DiagonalSystem,
+    scratch: Vec<Vec3>,
+    scratch_ids: Vec<u32>,
+}
+
+impl World {
+    /// Takes one step with the CFL-limited step size.
+    pub fn step(&mut self) -> Result<&StepStats, Error> {
+        self.step_with_dt(self.next_dt)
+    }
+
+    /// Takes one step of `dt` seconds (positive, finite). The CFL rule still sets the size
+    /// the following [`World::step`] will use.
+    pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
+        if !(dt.is_finite() && dt > 0.0 && dt <= 1.0) {
+            return Err(Error::invalid(
+                "dt",
+                dt,
+                "must be a positive finite number of seconds (at most 1)",
+            ));
+        }
+        if self.fluid_count() == 0 {
+            return Err(Error::invalid(
+                "fluid particles",
+                0,
+                "must be present before stepping",
+            ));
+        }
+        let stats = self.advance_one(dt);
+        self.time += dt;
+        self.steps += 1;
+        Ok(self.last.insert(stats))
+    }
+
+    /// Steps until `seconds` more simulated time has passed; the last step is shortened to
+    /// land exactly. Returns the number of steps taken.
+    pub fn advance(&mut self, seconds: f64) -> Result<usize, Error> {
+        if !(seconds.is_finite() && seconds >= 0.0) {
+            return Err(Error::invalid(
+                "seconds",
+                seconds,
+                "must be a non-negative finite number",
+            ));
+        }
+        let end = self.time + seconds;
+        let mut steps = 0;
+        while end - self.time > 1e-12 * end.abs().max(1.0) {
+            let dt = self.next_dt.min(end - self.time);
+            self.step_with_dt(dt)?;
+            steps += 1;
+        }
+        Ok(steps)
+    }
+
+    fn advance_one(&mut self, dt: f64) -> StepStats {
+        let started = Instant::now();
+        let gravity = Vec3::from(self.params.gravity);
+        let mut buffers = std::mem::take(&mut self.buffers);
+        // 1. Inertial prediction s = x + Δt v + Δt² g.
+        let fluid = &self.fluid;
+        self.pool.install(|| {
+            buffers
+                .predicted
+                .resize(fluid.positions.len(), Vec3::zeros());
+            buffers
+                .predicted
+                .par_iter_mut()
+                .zip(fluid.positions.par_iter().zip(fluid.velocities.par_iter()))
+                .for_each(|(s, (x, v))| *s = x + v * dt + gravity * (dt * dt));
+        });
+        self.prepare_grid(&buffers.predicted);
+        let mut timings = StepTimings::default();
+        let World {
+            params,
+            constraint,
+            pool,
+            fluid,
+            boundary,
+            grid,
+            solver,
+            chebyshev,
+            ..
+        } = self;
+        let grid = grid.as_ref().expect("prepare_grid builds the grid");
+        let stats = pool.install(|| {
+            let b = &mut buffers;
+            // 2. Sort into Z-order (all per-particle arrays), then search on s.
+            grid.sort(&b.predicted, &mut b.order, &mut b.table);
+            permute(&b.order, &mut fluid.positions, &mut b.scratch);
+            permute(&b.order, &mut fluid.velocities, &mut b.scratch);
+            permute(&b.order, &mut b.predicted, &mut b.scratch);
+            permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
+            let h = params.support_radius();
+            grid.search(
+                &b.table,
+                &b.predicted,
+                &b.predicted,
+                h,
+                true,
+                &mut b.fluid_lists,
+            );
+            grid.search(
+                &boundary.table,
+                &boundary.positions,
+                &b.predicted,
+                h,
+                false,
+                &mut b.boundary_lists,
+            );
+            b.fluid_lists.reverse_slots(&mut b.gather_slots);
+            let indices = &b.fluid_lists.indices;
+            b.gather_slots
+                .par_iter_mut()
+                .zip(indices.par_iter())
+                .for_each(|(g, &i)| *g += i + 1);
+            Neighborhood::stencil_offsets_of(&b.fluid_lists, &mut b.stencil_offsets);
+            timings.neighbors = started.elapsed().as_secs_f64();
+
+            // 3. The system matrix of formulation F1, frozen for the step.
+            let mass = constraint.mass;
+            let dt2k = dt * dt * params.stiffness;
+            let lists = &b.fluid_lists;
+            b.system.diagonal.resize(lists.len(), 0.0);
+            b.system
+                .diagonal
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(j, a)| *a = mass + dt2k * (lists.count(j) + 1) as f64);
+            solver.prepare(&b.system);
+
+            // 4. Outer local/global iterations from X^(0) = X^(−1) = s.
+            b.current.clone_from(&b.predicted);
+            b.previous.clone_from(&b.predicted);
+            b.next.resize(b.predicted.len(), Vec3::zeros());
+            b.rhs.resize(b.predicted.len(), Vec3::zeros());
+            let nb = Neighborhood {
+                fluid: &b.fluid_lists,
+                boundary: &b.boundary_lists,
+                boundary_positions: &boundary.positions,
+                boundary_psi: &boundary.psi,
+                stencil_offsets: &b.stencil_offsets,
+            };
+            chebyshev.reset();
+            let accelerate = params.solver == SolverKind::Chebyshev;
+            let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
+            while outer < params.max_outer_iterations {
+                let t = Instant::now();
+                constraint.project(&b.current, &nb, &mut b.corrections);
+                let t_local = t.elapsed().as_secs_f64();
+                let (corrections, slots, current) = (&b.corrections, &b.gather_slots, &b.current);
+                b.rhs.par_iter_mut().enumerate().for_each(|(j, rhs)| {
+                    // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction.
+                    let range = lists.offsets[j] as usize..lists.offsets[j + 1] as usize;
+                    let sum: Vec3 = corrections[nb.stencil_start(j)]
+                        + slots[range]
+                            .iter()
+                            .map(|&s| corrections[s as usize])
+                            .sum::<Vec3>();
+                    let members = (lists.count(j) + 1) as f64;
+                    *rhs = b.predicted[j] * mass + (current[j] * members + sum) * dt2k;
+                });
+                b.next.copy_from_slice(&b.current);
+                inner += solver.solve(&b.system, &b.rhs, &mut b.next);
+                if accelerate {
+                    let omega = chebyshev.next_weight(outer);
+                    chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
+                }
+                displacement = max_distance(&b.next, &b.current);
+                // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
+                std::mem::swap(&mut b.previous, &mut b.current);
+                std::mem::swap(&mut b.current, &mut b.next);
+                outer += 1;
+                timings.local += t_local;
+                timings.global += t.elapsed().as_secs_f64() - t_local;
+                if outer >= params.min_outer_iterations
+                    && displacement < params.displacement_tolerance
+                {
+                    break;
+                }
+            }
+
+            // 5. Velocity update v = (x^{n+1} − x^n)/Δt, then the new positions.
+            let t = Instant::now();
+            fluid
+                .velocities
+                .par_iter_mut()
+                .zip(b.current.par_iter().zip(fluid.positions.par_iter()))
+                .for_each(|(v, (new, old))| *v = (new - old) / dt);
+            std::mem::swap(&mut fluid.positions, &mut b.current);
+
+            // 6. Densities at the new positions (step's neighbour lists), 7. XSPH.
+            constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
+            if params.viscosity > 0.0 {
+                xsph(params.viscosity, constraint, &nb, fluid, &mut b.scratch);
+            }
+            let rest = constraint.rest_density;
+            let errors = |rho: &f64| (rho / rest - 1.0).max(0.0);
+            let n = fluid.densities.len() as f64;
+            let density_error_avg = reduce::sum(&fluid.densities, errors) / n;
+            let density_error_max = reduce::max(&fluid.densities, errors);
+            timings.rest = t.elapsed().as_secs_f64();
+            StepStats {
+                dt,
+                outer_iterations: outer,
+                inner_iterations: inner,
+                hit_max_iterations: displacement >= params.displacement_tolerance,
+                last_displacement: displacement,
+                density_error_avg,
+                density_error_max,
+                timings,
+            }
+        });
+        // 8. CFL: Δt = λ·0.4·2r / max|v + Δt g|, clamped.
+        let v_max = self.pool.install(|| {
+            reduce::max(&self.fluid.velocities, |v| {
+                (v + gravity * dt).norm_squared()
+            })
+        });
+        let v_max = v_max.max(1e-9).sqrt();
+        let p = &self.params;
+        let cfl = p.cfl_factor * 0.4 * p.spacing() / v_max;
+        self.next_dt = if cfl.is_finite() {
+            cfl.clamp(p.dt_min, p.dt_max)
+        } else {
+            p.dt_min
+        };
+        self.buffers = buffers;
+        stats
+    }
+}
+
+/// Reorders `data` so that slot k holds the old `data[order[k]]`.
+fn permute<T: Copy + Send + Sync + Default>(
+    order: &[u32],
+    data: &mut Vec<T>,
+    scratch: &mut Vec<T>,
+) {
+    scratch.resize(data.len(), T::default());
+    scratch
+        .par_iter_mut()
+        .zip(order.par_iter())
+        .for_each(|(s, &o)| *s = data[o as usize]);
+    std::mem::swap(data, scratch);
+}
+
+/// max_i |a_i − b_i| (m).
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
+    (0..a.len())
+        .into_par_iter()
+        .map(|i| (a[i] - b[i]).norm())
+        .reduce(
+            || 0.0,
+            |x, y| {
+                if x.is_nan() || y.is_nan() {
+                    f64::NAN
+                } else {
+                    x.max(y)
+                }
+            },
+        )
+}
+
+/// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (ALGORITHM.md §1.3).
+fn xsph(
+    c: f64,
+    constraint: &crate::constraint::DensityConstraint,
+    nb: &Neighborhood,
+    fluid: &mut crate::world::Fluid,
+    scratch: &mut Vec<Vec3>,
+) {
+    let (x, v, rho) = (&fluid.positions, &fluid.velocities, &fluid.densities);
+    scratch.resize(v.len(), Vec3::zeros());
+    scratch.par_iter_mut().enumerate().for_each(|(i, out)| {
+        let sum: Vec3 = nb
+            .fluid
+            .of(i)
+            .iter()
+            .map(|&j| {
+                let j = j as usize;
+                (v[j] - v[i])
+                    * (constraint.mass / rho[j] * constraint.kernel.w((x[i] - x[j]).norm()))
+            })
+            .sum();
+        *out = v[i] + sum * c;
+    });
+    std::mem::swap(&mut fluid.velocities, scratch);
+}

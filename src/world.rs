@@ -1,0 +1,424 @@
+//! The world: fluid particles (structure of arrays), static boundary particles, parameters,
+//! and the world's own thread pool. The CLI and the C API are thin shells over it.
+
+use crate::boundary::{Aabb, akinci_volumes, sample_box_walls};
+use crate::constraint::DensityConstraint;
+use crate::kernel::CubicKernel;
+use crate::neighbors::{CellTable, UniformGrid};
+use crate::params::{Params, SolverKind};
+use crate::solver::{Chebyshev, GlobalSolver, linear_solver};
+use crate::stats::StepStats;
+use crate::step::StepBuffers;
+use crate::{Error, Vec3, reduce};
+
+/// Fluid particles in their current storage order (Z-order after the first step).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Fluid {
+    pub positions: Vec<Vec3>,
+    pub velocities: Vec<Vec3>,
+    pub densities: Vec<f64>,
+    /// The order in which each particle was added; outputs are reported in this order.
+    pub ids: Vec<u32>,
+}
+
+/// Static boundary particles, sorted by the grid's cells, with their Akinci masses.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Boundary {
+    pub positions: Vec<Vec3>,
+    /// ψ_b = ρ0·V_b (kg), valid unless `dirty`.
+    pub psi: Vec<f64>,
+    pub table: CellTable,
+    /// Set when particles were added or the grid changed: sort and volumes must be redone.
+    pub dirty: bool,
+}
+
+/// A fluid simulation: particles, boundaries, parameters and the state of time stepping.
+pub struct World {
+    pub(crate) params: Params,
+    pub(crate) constraint: DensityConstraint,
+    pub(crate) pool: rayon::ThreadPool,
+    pub(crate) fluid: Fluid,
+    pub(crate) boundary: Boundary,
+    /// Container boxes; fluid outside all of them counts as escaped.
+    pub(crate) containers: Vec<Aabb>,
+    pub(crate) grid: Option<UniformGrid>,
+    /// The grid reached its cell limit and no longer grows.
+    pub(crate) grid_capped: bool,
+    pub(crate) solver: Box<dyn GlobalSolver>,
+    pub(crate) chebyshev: Chebyshev,
+    pub(crate) buffers: StepBuffers,
+    pub(crate) time: f64,
+    pub(crate) next_dt: f64,
+    pub(crate) steps: u64,
+    pub(crate) last: Option<StepStats>,
+}
+
+impl World {
+    /// An empty world with the given parameters (validated).
+    pub fn new(params: Params) -> Result<Self, Error> {
+        params.validate()?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(params.threads)
+            .build()
+            .map_err(|e| {
+                Error::invalid("threads", params.threads, &format!("could not start: {e}"))
+            })?;
+        Ok(Self {
+            constraint: DensityConstraint {
+                kernel: CubicKernel::new(params.support_radius()),
+                mass: params.particle_mass(),
+                rest_density: params.rest_density,
+                weight: params.projection_weight,
+            },
+            pool,
+            fluid: Fluid::default(),
+            boundary: Boundary::default(),
+            containers: Vec::new(),
+            grid: None,
+            grid_capped: false,
+            solver: linear_solver(params.solver),
+            chebyshev: Chebyshev::new(params.chebyshev),
+            buffers: StepBuffers::default(),
+            time: 0.0,
+            next_dt: params.dt_initial.clamp(params.dt_min, params.dt_max),
+            steps: 0,
+            last: None,
+            params,
+        })
+    }
+
+    /// The world's parameters.
+    pub fn params(&self) -> &Params {
+        &self.params
+    }
+
+    /// Switches the global solver (and Chebyshev settings) between steps.
+    pub fn set_solver(
+        &mut self,
+        kind: SolverKind,
+        chebyshev: crate::params::ChebyshevParams,
+    ) -> Result<(), Error> {
+        let mut params = self.params.clone();
+        params.solver = kind;
+        params.chebyshev = chebyshev;
+        params.validate()?;
+        self.params = params;
+        self.solver = linear_solver(kind);
+        self.chebyshev = Chebyshev::new(chebyshev);
+        Ok(())
+    }
+
+    /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
+    /// Rejects non-finite values and length mismatches without changing the world.
+    pub fn add_fluid_particles(
+        &mut self,
+        positions: &[Vec3],
+        velocities: Option<&[Vec3]>,
+    ) -> Result<(), Error> {
+        check_finite("positions", positions)?;
+        if let Some(v) = velocities {
+            if v.len() != positions.len() {
+                return Err(Error::invalid(
+                    "velocities",
+                    v.len(),
+                    &format!("must have one entry per position ({})", positions.len()),
+                ));
+            }
+            check_finite("velocities", v)?;
+        }
+        let first = self.fluid.positions.len();
+        if first + positions.len() > u32::MAX as usize / 64 {
+            return Err(Error::invalid(
+                "positions",
+                positions.len(),
+                "would exceed the particle limit",
+            ));
+        }
+        self.fluid.positions.extend_from_slice(positions);
+        match velocities {
+            Some(v) => self.fluid.velocities.extend_from_slice(v),
+            None => self
+                .fluid
+                .velocities
+                .resize(first + positions.len(), Vec3::zeros()),
+        }
+        self.fluid.densities.resize(first + positions.len(), 0.0);
+        self.fluid
+            .ids
+            .extend((first..first + positions.len()).map(|i| i as u32));
+        Ok(())
+    }
+
+    /// Adds a cubic lattice of fluid particles with spacing 2r: centres at
+    /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with `velocity`.
+    pub fn add_fluid_block(
+        &mut self,
+        start: Vec3,
+        count: [usize; 3],
+        velocity: Vec3,
+    ) -> Result<(), Error> {
+        let total = count.iter().try_fold(1usize, |acc, &c| acc.checked_mul(c));
+        match total {
+            Some(n) if n > 0 && n <= u32::MAX as usize / 64 => {}
+            _ => {
+                return Err(Error::invalid(
+                    "count",
+                    format!("{count:?}"),
+                    "must be positive and not absurdly large",
+                ));
+            }
+        }
+        let d = self.params.spacing();
+        let positions: Vec<Vec3> = (0..count[2])
+            .flat_map(|k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
+            .map(|(i, j, k)| start + Vec3::new(i as f64, j as f64, k as f64) * d)
+            .collect();
+        check_finite("start", &[start, velocity])?;
+        self.add_fluid_particles(&positions, Some(&vec![velocity; positions.len()]))
+    }
+
+    /// Adds static boundary particles at `positions` (m).
+    pub fn add_boundary_particles(&mut self, positions: &[Vec3]) -> Result<(), Error> {
+        check_finite("positions", positions)?;
+        self.boundary.positions.extend_from_slice(positions);
+        self.boundary.dirty = true;
+        Ok(())
+    }
+
+    /// Adds a closed container box: its six walls sampled with boundary particles of spacing r,
+    /// `layers` layers thick (1–3). Fluid outside every container counts as escaped.
+    pub fn add_container(&mut self, container: Aabb, layers: usize) -> Result<(), Error> {
+        check_finite("container", &[container.min, container.max])?;
+        let r = self.params.particle_radius;
+        let size = container.max - container.min;
+        if (0..3).any(|a| size[a] < 2.0 * self.params.spacing()) {
+            return Err(Error::invalid(
+                "container",
+                format!(
+                    "{:?}..{:?}",
+                    container.min.as_slice(),
+                    container.max.as_slice()
+                ),
+                "must be at least two particle spacings wide along every axis",
+            ));
+        }
+        if !(1..=3).contains(&layers) {
+            return Err(Error::invalid("layers", layers, "must be 1, 2 or 3"));
+        }
+        if size.iter().any(|&s| s / r > 1e5) {
+            return Err(Error::invalid(
+                "container",
+                format!("{:?}", size.as_slice()),
+                "is too large for the particle radius",
+            ));
+        }
+        let samples = sample_box_walls(&container, r, layers);
+        self.add_boundary_particles(&samples)?;
+        self.containers.push(container);
+        Ok(())
+    }
+
+    /// Number of fluid particles.
+    pub fn fluid_count(&self) -> usize {
+        self.fluid.positions.len()
+    }
+
+    /// Number of boundary particles.
+    pub fn boundary_count(&self) -> usize {
+        self.boundary.positions.len()
+    }
+
+    /// Simulated time (s).
+    pub fn time(&self) -> f64 {
+        self.time
+    }
+
+    /// Steps taken so far.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// The time step (s) the next CFL-limited step will use.
+    pub fn next_dt(&self) -> f64 {
+        self.next_dt
+    }
+
+    /// Statistics of the last step, if any step was taken.
+    pub fn last_step(&self) -> Option<&StepStats> {
+        self.last.as_ref()
+    }
+
+    /// The container boxes added so far.
+    pub fn containers(&self) -> &[Aabb] {
+        &self.containers
+    }
+
+    /// Fluid particle mass m (kg).
+    pub fn particle_mass(&self) -> f64 {
+        self.constraint.mass
+    }
+
+    /// Copies a per-particle quantity into `out` in the order the particles were added.
+    fn gather_by_id<T: Copy>(&self, values: &[T], out: &mut [T]) {
+        for (v, &id) in values.iter().zip(&self.fluid.ids) {
+            out[id as usize] = *v;
+        }
+    }
+
+    /// Fluid positions (m) in the order they were added.
+    pub fn positions(&self) -> Vec<Vec3> {
+        let mut out = vec![Vec3::zeros(); self.fluid_count()];
+        self.gather_by_id(&self.fluid.positions, &mut out);
+        out
+    }
+
+    /// Fluid velocities (m/s) in the order the particles were added.
+    pub fn velocities(&self) -> Vec<Vec3> {
+        let mut out = vec![Vec3::zeros(); self.fluid_count()];
+        self.gather_by_id(&self.fluid.velocities, &mut out);
+        out
+    }
+
+    /// Fluid densities (kg/m³) after the last step, in the order the particles were added
+    /// (zero before the first step).
+    pub fn densities(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.fluid_count()];
+        self.gather_by_id(&self.fluid.densities, &mut out);
+        out
+    }
+
+    /// Static boundary particle positions (m), in the world's storage order.
+    pub fn boundary_positions(&self) -> &[Vec3] {
+        &self.boundary.positions
+    }
+
+    /// Kinetic energy Σ ½m|v|² (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        let m = self.constraint.mass;
+        self.pool
+            .install(|| reduce::sum(&self.fluid.velocities, |v| 0.5 * m * v.norm_squared()))
+    }
+
+    /// Potential energy −Σ m g·x (J), zero at the origin.
+    pub fn potential_energy(&self) -> f64 {
+        let m = self.constraint.mass;
+        let g = Vec3::from(self.params.gravity);
+        self.pool
+            .install(|| reduce::sum(&self.fluid.positions, |x| -m * g.dot(x)))
+    }
+
+    /// Root-mean-square speed of the fluid (m/s).
+    pub fn rms_velocity(&self) -> f64 {
+        let n = self.fluid_count().max(1) as f64;
+        (self
+            .pool
+            .install(|| reduce::sum(&self.fluid.velocities, |v| v.norm_squared()))
+            / n)
+            .sqrt()
+    }
+
+    /// Fluid particles farther than r/2 outside every container, or non-finite (0 without containers).
+    pub fn escaped_count(&self) -> usize {
+        if self.containers.is_empty() {
+            return 0;
+        }
+        let margin = 0.5 * self.params.particle_radius;
+        self.fluid
+            .positions
+            .iter()
+            .filter(|p| !self.containers.iter().any(|c| c.contains(p, margin)))
+            .count()
+    }
+
+    /// Number of fluid particles with a non-finite position or velocity.
+    pub fn nan_count(&self) -> usize {
+        let bad = |v: &Vec3| !v.iter().all(|c| c.is_finite());
+        self.fluid
+            .positions
+            .iter()
+            .zip(&self.fluid.velocities)
+            .filter(|(x, v)| bad(x) || bad(v))
+            .count()
+    }
+
+    /// A hex SHA-256 digest of the positions' bit patterns in the order the particles were
+    /// added; equal digests mean bitwise identical positions.
+    pub fn positions_hash(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut hasher = Sha256::new();
+        for p in self.positions() {
+            for c in p.iter() {
+                hasher.update(c.to_bits().to_le_bytes());
+            }
+        }
+        hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    }
+
+    /// Makes sure the grid covers all particles and the boundary is sorted with volumes.
+    /// The grid is rebuilt (with slack) when particles leave it, unless it already hit its
+    /// cell limit; then outlying particles are clamped into border cells, which stays correct.
+    pub(crate) fn prepare_grid(&mut self, points: &[Vec3]) {
+        let outgrown = match &self.grid {
+            None => true,
+            Some(g) => !self.grid_capped && !self.pool.install(|| g.covers(points)),
+        };
+        if outgrown || self.boundary.dirty {
+            let bounds = [points, &self.boundary.positions]
+                .iter()
+                .filter_map(|p| Aabb::around(p))
+                .reduce(|a, b| a.union(&b));
+            let Some(bounds) = bounds else { return };
+            let finite = |v: Vec3| {
+                v.map(|c| {
+                    if c.is_finite() {
+                        c.clamp(-1e6, 1e6)
+                    } else {
+                        0.0
+                    }
+                })
+            };
+            // A quarter of the extent as slack, so a splash does not rebuild the grid every step.
+            let slack = (bounds.max - bounds.min) * 0.25;
+            let h = self.params.support_radius();
+            let grid =
+                UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h);
+            self.grid_capped = !self.pool.install(|| grid.covers(points));
+            self.grid = Some(grid);
+            self.boundary.dirty = true;
+        }
+        if self.boundary.dirty {
+            self.sort_boundary();
+        }
+    }
+
+    fn sort_boundary(&mut self) {
+        let Some(grid) = &self.grid else { return };
+        let b = &mut self.boundary;
+        let mut order = Vec::new();
+        self.pool.install(|| {
+            grid.sort(&b.positions, &mut order, &mut b.table);
+            b.positions = order.iter().map(|&i| b.positions[i as usize]).collect();
+            let volumes = akinci_volumes(grid, &b.table, &b.positions, &self.constraint.kernel);
+            b.psi = volumes
+                .iter()
+                .map(|v| v * self.params.rest_density)
+                .collect();
+        });
+        b.dirty = false;
+    }
+}
+
+fn check_finite(field: &str, values: &[Vec3]) -> Result<(), Error> {
+    match values.iter().position(|v| !v.iter().all(|c| c.is_finite())) {
+        Some(i) => Err(Error::invalid(
+            format!("{field}[{i}]"),
+            format!("{:?}", values[i].as_slice()),
+            "must be finite",
+        )),
+        None => Ok(()),
+    }
+}

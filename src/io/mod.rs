@@ -1,1 +1,5 @@
 //! Frame writers.
+
+pub mod vtk;
+
+pub use vtk::write_vtk;

@@ -1,0 +1,371 @@
+//! The JSON form of a scene: serde structures mirroring `docs/scene-format.md`, their
+//! conversion to and from [`Scene`], and a printer that keeps number arrays on one line.
+
+use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
+use crate::Error;
+use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
+use serde::de::{MapAccess, SeqAccess, Visitor};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+/// The top-level JSON object. Optional keys are `None` when absent.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SceneFile {
+    name: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    description: Option<String>,
+    particle_radius: f64,
+    rest_density: Option<f64>,
+    mass_factor: Option<f64>,
+    stiffness: Option<f64>,
+    gravity: Option<[f64; 3]>,
+    container: Option<Containers>,
+    fluid_blocks: Vec<FluidBlock>,
+    solver: Option<SolverFile>,
+    time: Option<TimeFile>,
+    viscosity: Option<f64>,
+    threads: Option<usize>,
+    duration: f64,
+    output: Option<OutputFile>,
+}
+
+/// `solver`: the global solver and the outer iteration.
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct SolverFile {
+    kind: Option<SolverName>,
+    rho: Option<f64>,
+    delay: Option<usize>,
+    omega2: Option<Omega2Name>,
+    gamma: Option<f64>,
+    tau: Option<f64>,
+    max_iterations: Option<usize>,
+    min_iterations: Option<usize>,
+    projection_weight: Option<WeightName>,
+}
+
+/// `time`: step size control.
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct TimeFile {
+    cfl_factor: Option<f64>,
+    dt_min: Option<f64>,
+    dt_max: Option<f64>,
+    dt_initial: Option<f64>,
+}
+
+/// `output`: frame directory and interval.
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct OutputFile {
+    dir: Option<String>,
+    every: Option<usize>,
+}
+
+/// `solver.kind` values.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum SolverName {
+    Chebyshev,
+    Jacobi1,
+    Jacobi,
+}
+
+/// `solver.omega2` values.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(rename_all = "lowercase")]
+enum Omega2Name {
+    Chebyshev,
+    Seed,
+}
+
+/// `solver.projection_weight` values.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(rename_all = "snake_case")]
+enum WeightName {
+    NeighborCount,
+    Unit,
+}
+
+impl From<SolverName> for SolverKind {
+    fn from(n: SolverName) -> Self {
+        match n {
+            SolverName::Chebyshev => SolverKind::Chebyshev,
+            SolverName::Jacobi1 => SolverKind::Jacobi1,
+            SolverName::Jacobi => SolverKind::Jacobi,
+        }
+    }
+}
+
+impl From<SolverKind> for SolverName {
+    fn from(k: SolverKind) -> Self {
+        match k {
+            SolverKind::Chebyshev => SolverName::Chebyshev,
+            SolverKind::Jacobi1 => SolverName::Jacobi1,
+            SolverKind::Jacobi => SolverName::Jacobi,
+        }
+    }
+}
+
+impl From<Omega2Name> for Omega2Rule {
+    fn from(n: Omega2Name) -> Self {
+        match n {
+            Omega2Name::Chebyshev => Omega2Rule::Chebyshev,
+            Omega2Name::Seed => Omega2Rule::SeedLiteral,
+        }
+    }
+}
+
+impl From<Omega2Rule> for Omega2Name {
+    fn from(r: Omega2Rule) -> Self {
+        match r {
+            Omega2Rule::Chebyshev => Omega2Name::Chebyshev,
+            Omega2Rule::SeedLiteral => Omega2Name::Seed,
+        }
+    }
+}
+
+impl From<WeightName> for ProjectionWeight {
+    fn from(n: WeightName) -> Self {
+        match n {
+            WeightName::NeighborCount => ProjectionWeight::NeighborCount,
+            WeightName::Unit => ProjectionWeight::Unit,
+        }
+    }
+}
+
+impl From<ProjectionWeight> for WeightName {
+    fn from(w: ProjectionWeight) -> Self {
+        match w {
+            ProjectionWeight::NeighborCount => WeightName::NeighborCount,
+            ProjectionWeight::Unit => WeightName::Unit,
+        }
+    }
+}
+
+/// `container`: one object or an array of objects; written back as an array.
+struct Containers(Vec<ContainerSpec>);
+
+impl Serialize for Containers {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        self.0.serialize(s)
+    }
+}
+
+impl<'de> Deserialize<'de> for Containers {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct OneOrMany;
+        impl<'de> Visitor<'de> for OneOrMany {
+            type Value = Containers;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a container object or an array of container objects")
+            }
+            fn visit_map<A: MapAccess<'de>>(self, map: A) -> Result<Containers, A::Error> {
+                ContainerSpec::deserialize(MapAccessDeserializer::new(map))
+                    .map(|c| Containers(vec![c]))
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, seq: A) -> Result<Containers, A::Error> {
+                Vec::deserialize(SeqAccessDeserializer::new(seq)).map(Containers)
+            }
+        }
+        d.deserialize_any(OneOrMany)
+    }
+}
+
+/// Parses scene JSON without validating values. `origin` (the file, if any) and the line and
+/// column start the message of a JSON error; `default_name` names a scene without `name`.
+pub(super) fn parse(text: &str, origin: Option<&Path>, default_name: &str) -> Result<Scene, Error> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let file: SceneFile = serde_path_to_error::deserialize(&mut de)
+        .map_err(|e| {
+            let path = e.path().to_string();
+            json_error(e.into_inner(), &path, origin)
+        })
+        .and_then(|f| de.end().map(|()| f).map_err(|e| json_error(e, ".", origin)))?;
+    Ok(file.into_scene(default_name))
+}
+
+/// A JSON error as "FILE: line L column C: PATH: MESSAGE".
+fn json_error(e: serde_json::Error, path: &str, origin: Option<&Path>) -> Error {
+    let (line, column) = (e.line(), e.column());
+    let mut message = e.to_string();
+    let suffix = format!(" at line {line} column {column}");
+    if let Some(stripped) = message.strip_suffix(&suffix) {
+        message = stripped.to_string();
+    }
+    let syntax = e.is_syntax() || e.is_eof();
+    // An unknown key's path ends with the key itself; name the object that holds it instead.
+    let mut path = path;
+    if let Some(key) = message
+        .strip_prefix("unknown field `")
+        .and_then(|rest| rest.split('`').next())
+    {
+        if let Some(parent) = path.strip_suffix(key) {
+            path = parent.strip_suffix('.').unwrap_or(".");
+            if path.is_empty() {
+                path = ".";
+            }
+        }
+    }
+    let field = if syntax || path == "." { "scene" } else { path };
+    let mut out = String::new();
+    if let Some(p) = origin {
+        out.push_str(&format!("{}: ", p.display()));
+    }
+    out.push_str(&format!("line {line} column {column}: "));
+    if syntax {
+        out.push_str("invalid JSON: ");
+    } else if path != "." {
+        out.push_str(&format!("{path}: "));
+    }
+    out.push_str(&message);
+    Error::InvalidArgument {
+        field: field.to_string(),
+        message: out,
+    }
+}
+
+impl SceneFile {
+    /// Fills in defaults from [`Params::with_radius`].
+    fn into_scene(self, default_name: &str) -> Scene {
+        let mut p = Params::with_radius(self.particle_radius);
+        let set = |slot: &mut f64, v: Option<f64>| *slot = v.unwrap_or(*slot);
+        set(&mut p.rest_density, self.rest_density);
+        set(&mut p.mass_factor, self.mass_factor);
+        set(&mut p.stiffness, self.stiffness);
+        p.gravity = self.gravity.unwrap_or(p.gravity);
+        set(&mut p.viscosity, self.viscosity);
+        p.threads = self.threads.unwrap_or(p.threads);
+        let s = self.solver.unwrap_or_default();
+        p.solver = s.kind.map_or(p.solver, SolverKind::from);
+        let c: &mut ChebyshevParams = &mut p.chebyshev;
+        set(&mut c.rho, s.rho);
+        c.delay = s.delay.unwrap_or(c.delay);
+        c.omega2_rule = s.omega2.map_or(c.omega2_rule, Omega2Rule::from);
+        set(&mut c.gamma, s.gamma);
+        set(&mut p.displacement_tolerance, s.tau);
+        p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
+        p.min_outer_iterations = s.min_iterations.unwrap_or(p.min_outer_iterations);
+        p.projection_weight = s
+            .projection_weight
+            .map_or(p.projection_weight, ProjectionWeight::from);
+        let t = self.time.unwrap_or_default();
+        set(&mut p.cfl_factor, t.cfl_factor);
+        set(&mut p.dt_min, t.dt_min);
+        set(&mut p.dt_max, t.dt_max);
+        set(&mut p.dt_initial, t.dt_initial);
+        let o = self.output.unwrap_or_default();
+        Scene {
+            name: self.name.unwrap_or_else(|| default_name.to_string()),
+            description: self.description.unwrap_or_default(),
+            params: p,
+            containers: self.container.map(|c| c.0).unwrap_or_default(),
+            fluid_blocks: self.fluid_blocks,
+            duration: self.duration,
+            output: OutputSpec {
+                dir: o.dir.map(PathBuf::from),
+                every: o.every.unwrap_or(super::DEFAULT_OUTPUT_EVERY),
+            },
+        }
+    }
+
+    /// Every key written out.
+    fn from_scene(scene: &Scene) -> Self {
+        let p = &scene.params;
+        let c = &p.chebyshev;
+        SceneFile {
+            name: Some(scene.name.clone()),
+            description: Some(scene.description.clone()).filter(|d| !d.is_empty()),
+            particle_radius: p.particle_radius,
+            rest_density: Some(p.rest_density),
+            mass_factor: Some(p.mass_factor),
+            stiffness: Some(p.stiffness),
+            gravity: Some(p.gravity),
+            container: Some(Containers(scene.containers.clone())),
+            fluid_blocks: scene.fluid_blocks.clone(),
+            solver: Some(SolverFile {
+                kind: Some(p.solver.into()),
+                rho: Some(c.rho),
+                delay: Some(c.delay),
+                omega2: Some(c.omega2_rule.into()),
+                gamma: Some(c.gamma),
+                tau: Some(p.displacement_tolerance),
+                max_iterations: Some(p.max_outer_iterations),
+                min_iterations: Some(p.min_outer_iterations),
+                projection_weight: Some(p.projection_weight.into()),
+            }),
+            time: Some(TimeFile {
+                cfl_factor: Some(p.cfl_factor),
+                dt_min: Some(p.dt_min),
+                dt_max: Some(p.dt_max),
+                dt_initial: Some(p.dt_initial),
+            }),
+            viscosity: Some(p.viscosity),
+            threads: Some(p.threads),
+            duration: scene.duration,
+            output: Some(OutputFile {
+                dir: scene
+                    .output
+                    .dir
+                    .as_ref()
+                    .map(|d| d.to_string_lossy().into_owned()),
+                every: Some(scene.output.every),
+            }),
+        }
+    }
+}
+
+/// Pretty JSON of every key, with arrays of numbers on one line.
+pub(super) fn to_json(scene: &Scene) -> String {
+    // Serialising plain data with string keys cannot fail; fall back to compact output anyway.
+    let file = SceneFile::from_scene(scene);
+    let pretty = serde_json::to_string_pretty(&file)
+        .or_else(|_| serde_json::to_string(&file))
+        .unwrap_or_default();
+    inline_number_arrays(&pretty)
+}
+
+/// Rewrites every array that holds no string, object or array onto one line.
+fn inline_number_arrays(json: &str) -> String {
+    let bytes = json.as_bytes();
+    let mut out = String::with_capacity(json.len());
+    let (mut i, mut in_string, mut escaped) = (0, false, false);
+    while i < bytes.len() {
+        let b = bytes[i];
+        if in_string {
+            if escaped {
+                escaped = false;
+            } else if b == b'\\' {
+                escaped = true;
+            } else if b == b'"' {
+                in_string = false;
+            }
+        } else if b == b'"' {
+            in_string = true;
+        } else if b == b'[' {
+            let rest = &json[i + 1..];
+            if let Some(end) = rest.find([']', '[', '{', '"']) {
+                if rest.as_bytes()[end] == b']' {
+                    let items: Vec<&str> = rest[..end]
+                        .split(',')
+                        .map(str::trim)
+                        .filter(|s| !s.is_empty())
+                        .collect();
+                    out.push('[');
+                    out.push_str(&items.join(", "));
+                    out.push(']');
+                    i += end + 2;
+                    continue;
+                }
+            }
+        }
+        // Copy the whole UTF-8 character starting here.
+        let len = json[i..].chars().next().map_or(1, char::len_utf8);
+        out.push_str(&json[i..i + len]);
+        i += len;
+    }
+    out
+}

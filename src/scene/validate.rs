@@ -1,0 +1,233 @@
+//! Checks of a [`Scene`]'s values; errors name the JSON key and the value.
+
+use super::{ContainerSpec, FluidBlock, Scene};
+use crate::Error;
+
+/// The most fluid particles a world accepts (see `World::add_fluid_particles`).
+const MAX_PARTICLES: usize = u32::MAX as usize / 64;
+
+/// Largest container extent in particle radii (see `World::add_container`).
+const MAX_EXTENT_PER_RADIUS: f64 = 1e5;
+
+/// Checks the whole scene; the first problem found is returned.
+pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
+    let r = scene.params.particle_radius;
+    if !(r.is_finite() && r > 0.0) {
+        return Err(Error::invalid(
+            "particle_radius",
+            r,
+            "must be a positive finite number",
+        ));
+    }
+    scene.params.validate().map_err(to_json_key)?;
+    if !(scene.duration.is_finite() && scene.duration > 0.0) {
+        return Err(Error::invalid(
+            "duration",
+            scene.duration,
+            "must be a positive finite number of seconds",
+        ));
+    }
+    if scene.output.every < 1 {
+        return Err(Error::invalid(
+            "output.every",
+            scene.output.every,
+            "must be at least 1",
+        ));
+    }
+    for (i, c) in scene.containers.iter().enumerate() {
+        check_container(i, c, r)?;
+    }
+    if scene.fluid_blocks.is_empty() {
+        return Err(Error::invalid(
+            "fluid_blocks",
+            "[]",
+            "must not be empty (a scene needs at least one block of fluid)",
+        ));
+    }
+    let mut total = 0usize;
+    for (i, b) in scene.fluid_blocks.iter().enumerate() {
+        check_block(i, b)?;
+        total = total.saturating_add(b.particle_count());
+        if total > MAX_PARTICLES {
+            return Err(Error::invalid(
+                "fluid_blocks",
+                total,
+                &format!("must hold at most {MAX_PARTICLES} particles in all"),
+            ));
+        }
+        check_inside(i, b, &scene.containers, 2.0 * r)?;
+    }
+    Ok(())
+}
+
+/// Renames a [`crate::Params::validate`] error's field to its JSON key (e.g. `rho` → `solver.rho`).
+fn to_json_key(error: Error) -> Error {
+    let Error::InvalidArgument { field, message } = error else {
+        return error;
+    };
+    let key = match field.as_str() {
+        "rho" | "delay" | "gamma" => format!("solver.{field}"),
+        "displacement_tolerance" => "solver.tau".to_string(),
+        "min_outer_iterations" => "solver.min_iterations".to_string(),
+        "max_outer_iterations" => "solver.max_iterations".to_string(),
+        "cfl_factor" | "dt_min" | "dt_max" | "dt_initial" => format!("time.{field}"),
+        _ => field.clone(),
+    };
+    let message = match message.strip_prefix(field.as_str()) {
+        Some(rest) => format!(
+            "{key}{}",
+            rest.replace("min_outer_iterations", "solver.min_iterations")
+        ),
+        None => message,
+    };
+    let message = message.replace("must not exceed dt_max", "must not exceed time.dt_max");
+    Error::InvalidArgument {
+        field: key,
+        message,
+    }
+}
+
+/// Finite corners, a non-degenerate box of at least two spacings per axis, 1–3 layers.
+fn check_container(i: usize, c: &ContainerSpec, r: f64) -> Result<(), Error> {
+    let field = format!("container[{i}]");
+    for (name, v) in [("min", c.min), ("max", c.max)] {
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                format!("{field}.{name}"),
+                format!("{v:?}"),
+                "must be finite",
+            ));
+        }
+    }
+    for (a, axis) in AXES.iter().enumerate() {
+        let size = c.max[a] - c.min[a];
+        if size < 4.0 * r {
+            return Err(Error::invalid(
+                format!("{field}.max"),
+                format!("{:?}", c.max),
+                &format!(
+                    "must exceed min {:?} by at least two particle spacings ({}) along {axis}",
+                    c.min,
+                    short(4.0 * r)
+                ),
+            ));
+        }
+        if size / r > MAX_EXTENT_PER_RADIUS {
+            return Err(Error::invalid(
+                field,
+                format!("{:?}..{:?}", c.min, c.max),
+                "is too large for the particle radius (at most 1e5 radii per axis)",
+            ));
+        }
+    }
+    if !(1..=3).contains(&c.layers) {
+        return Err(Error::invalid(
+            format!("{field}.layers"),
+            c.layers,
+            "must be 1, 2 or 3",
+        ));
+    }
+    Ok(())
+}
+
+/// Finite start and velocity, at least one particle per axis.
+fn check_block(i: usize, b: &FluidBlock) -> Result<(), Error> {
+    let field = format!("fluid_blocks[{i}]");
+    for (name, v) in [("start", b.start), ("velocity", b.velocity)] {
+        if v.iter().any(|x| !x.is_finite()) {
+            return Err(Error::invalid(
+                format!("{field}.{name}"),
+                format!("{v:?}"),
+                "must be finite",
+            ));
+        }
+    }
+    if b.count.contains(&0) {
+        return Err(Error::invalid(
+            format!("{field}.count"),
+            format!("{:?}", b.count),
+            "must be at least 1 along every axis",
+        ));
+    }
+    Ok(())
+}
+
+const AXES: [&str; 3] = ["x", "y", "z"];
+
+/// Every particle centre of block `i` (lattice spacing `d`) lies in some container (or there
+/// are no containers). A block that straddles two containers is fine.
+fn check_inside(
+    i: usize,
+    b: &FluidBlock,
+    containers: &[ContainerSpec],
+    d: f64,
+) -> Result<(), Error> {
+    if containers.is_empty() {
+        return Ok(());
+    }
+    let tol = 1e-6 * d;
+    let lo = b.start;
+    let hi: [f64; 3] = std::array::from_fn(|a| b.start[a] + (b.count[a] - 1) as f64 * d);
+    let inside = |c: &ContainerSpec, p: &[f64; 3], q: &[f64; 3]| {
+        (0..3).all(|a| p[a] >= c.min[a] - tol && q[a] <= c.max[a] + tol)
+    };
+    if containers.iter().any(|c| inside(c, &lo, &hi)) {
+        return Ok(());
+    }
+    let field = format!("fluid_blocks[{i}]");
+    if let [c] = containers {
+        for (a, axis) in AXES.iter().enumerate() {
+            let why = if lo[a] < c.min[a] - tol {
+                format!(
+                    "min {axis} {} < container min {}",
+                    short(lo[a]),
+                    short(c.min[a])
+                )
+            } else if hi[a] > c.max[a] + tol {
+                format!(
+                    "max {axis} {} > container max {}",
+                    short(hi[a]),
+                    short(c.max[a])
+                )
+            } else {
+                continue;
+            };
+            return Err(Error::InvalidArgument {
+                message: format!("{field} lies outside the container: {why}"),
+                field,
+            });
+        }
+    }
+    // Several containers: look for the first particle in none of them.
+    for k in 0..b.count[2] {
+        for j in 0..b.count[1] {
+            for n in 0..b.count[0] {
+                let p = [n, j, k].map(|c| c as f64 * d);
+                let p: [f64; 3] = std::array::from_fn(|a| b.start[a] + p[a]);
+                if !containers.iter().any(|c| inside(c, &p, &p)) {
+                    return Err(Error::InvalidArgument {
+                        message: format!(
+                            "{field} lies outside every container: particle [{n}, {j}, {k}] at ({}, {}, {})",
+                            short(p[0]),
+                            short(p[1]),
+                            short(p[2])
+                        ),
+                        field,
+                    });
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
+/// A length for messages: at most nine decimals, trailing zeros dropped, one decimal kept.
+fn short(x: f64) -> String {
+    let s = format!("{x:.9}");
+    let s = s.trim_end_matches('0');
+    if s.ends_with('.') {
+        format!("{s}0")
+    } else {
+        s.to_string()
+    }
+}

@@ -143,12 +143,20 @@ impl Scene {
         if path.is_file() {
             return Scene::load(path);
         }
+        let names = Scene::builtin_names().join(", ");
+        let looks_like_path = name_or_path.ends_with(".json")
+            || name_or_path.contains(std::path::MAIN_SEPARATOR)
+            || name_or_path.contains('/');
+        let message = if looks_like_path {
+            format!("scene file {name_or_path} does not exist (built-in scenes: {names})")
+        } else {
+            format!(
+                "scene `{name_or_path}` is neither a built-in scene ({names}) nor an existing file"
+            )
+        };
         Err(Error::InvalidArgument {
             field: "scene".to_string(),
-            message: format!(
-                "scene `{name_or_path}` is neither a built-in scene ({}) nor an existing file",
-                Scene::builtin_names().join(", ")
-            ),
+            message,
         })
     }
 

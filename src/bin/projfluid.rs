@@ -1,1 +1,431 @@
-fn main() {}
+//! `projfluid`: runs a scene (built-in or JSON file) and reports how the solver did.
+//!
+//! ```text
+//! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi]
+//!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
+//! projfluid scenes
+//! ```
+//!
+//! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
+
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use projfluid::io::write_vtk;
+use projfluid::scene::Scene;
+use projfluid::stats::{RunAccumulator, RunSummary, StepStats};
+use projfluid::{Error, SolverKind, World};
+use std::fs::File;
+use std::io::{IsTerminal, Write};
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Command line.
+#[derive(Parser)]
+#[command(
+    name = "projfluid",
+    version,
+    about = "Projective-fluids SPH solver with Chebyshev acceleration"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// Subcommands.
+#[derive(Subcommand)]
+enum Command {
+    /// Run a scene and print a summary of the run.
+    Run(RunArgs),
+    /// List the built-in scenes.
+    Scenes,
+}
+
+/// Options of `projfluid run`; each given option replaces the scene's setting.
+#[derive(Args)]
+struct RunArgs {
+    /// A built-in scene name (see `projfluid scenes`) or the path of a JSON scene file.
+    scene: String,
+    /// Simulated time to run, in seconds [default: the scene's duration].
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        conflicts_with = "steps",
+        allow_negative_numbers = true
+    )]
+    duration: Option<f64>,
+    /// Number of time steps to run, instead of a duration.
+    #[arg(long, value_name = "N")]
+    steps: Option<u64>,
+    /// Global solver.
+    #[arg(long, value_enum)]
+    solver: Option<SolverArg>,
+    /// Chebyshev spectral radius estimate ρ_c, in [0, 1).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    rho: Option<f64>,
+    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    tau: Option<f64>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N")]
+    threads: Option<usize>,
+    /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Write a frame every N steps (and the initial state as frame 0).
+    #[arg(long, value_name = "N")]
+    every: Option<usize>,
+    /// Write the run summary as JSON to this file.
+    #[arg(long, value_name = "FILE")]
+    stats: Option<PathBuf>,
+}
+
+/// `--solver` values.
+#[derive(Clone, Copy, ValueEnum)]
+enum SolverArg {
+    /// One Jacobi sweep per outer iteration with Chebyshev extrapolation.
+    Chebyshev,
+    /// Exactly one Jacobi sweep per outer iteration.
+    Jacobi1,
+    /// Jacobi sweeps to convergence in every outer iteration.
+    Jacobi,
+}
+
+impl From<SolverArg> for SolverKind {
+    fn from(s: SolverArg) -> Self {
+        match s {
+            SolverArg::Chebyshev => SolverKind::Chebyshev,
+            SolverArg::Jacobi1 => SolverKind::Jacobi1,
+            SolverArg::Jacobi => SolverKind::Jacobi,
+        }
+    }
+}
+
+/// Why the program stops early; decides the exit code.
+enum Failure {
+    /// Bad scene or option (exit 2).
+    Input(String),
+    /// The run itself failed, e.g. output could not be written (exit 1).
+    Runtime(String),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Run(args) => run(&args),
+        Command::Scenes => list_scenes(),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(Failure::Input(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(2)
+        }
+        Err(Failure::Runtime(msg)) => {
+            eprintln!("error: {msg}");
+            ExitCode::from(1)
+        }
+    }
+}
+
+/// `projfluid scenes`: one line per built-in scene.
+fn list_scenes() -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    for name in Scene::builtin_names() {
+        if let Some(scene) = Scene::builtin(name) {
+            let line = format!(
+                "{name:<20} {:>8} particles  {:>5} s simulated\n",
+                scene.particle_count(),
+                scene.duration
+            );
+            out.write_all(line.as_bytes())
+                .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))?;
+        }
+    }
+    Ok(())
+}
+
+/// How long to run.
+#[derive(Clone, Copy)]
+enum Target {
+    /// Simulated seconds.
+    Time(f64),
+    /// Steps.
+    Steps(u64),
+}
+
+/// `projfluid run`.
+fn run(args: &RunArgs) -> Result<(), Failure> {
+    let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
+    let target = apply_overrides(&mut scene, args)?;
+    let mut world = scene
+        .build_world()
+        .map_err(|e| Failure::Input(e.to_string()))?;
+    // Open the stats file first, so that an unwritable path fails before a long run.
+    let stats_file = match &args.stats {
+        Some(path) => Some((
+            File::create(path).map_err(|e| {
+                Failure::Runtime(format!("cannot write stats file {}: {e}", path.display()))
+            })?,
+            path,
+        )),
+        None => None,
+    };
+    let mut frames = match &scene.output.dir {
+        Some(dir) => Some(Frames::new(dir, scene.output.every)?),
+        None => None,
+    };
+    if let Some(f) = frames.as_mut() {
+        f.write(&world)?;
+    }
+    let mut acc = RunAccumulator::default();
+    let mut progress = Progress::new(target);
+    let (start, end) = (world.time(), world.time() + scene.duration);
+    loop {
+        let dt = match target {
+            Target::Time(_) => {
+                let left = end - world.time();
+                if left <= 1e-12 * end.abs().max(1.0) {
+                    break;
+                }
+                world.next_dt().min(left)
+            }
+            Target::Steps(n) if acc.steps() >= n => break,
+            Target::Steps(_) => world.next_dt(),
+        };
+        let clock = Instant::now();
+        let stats = world
+            .step_with_dt(dt)
+            .map_err(|e| Failure::Runtime(format!("step {} failed: {e}", acc.steps() + 1)))?
+            .clone();
+        let wall = clock.elapsed().as_secs_f64();
+        acc.add(&stats, wall);
+        if let Some(f) = frames.as_mut() {
+            if acc.steps() % f.every as u64 == 0 {
+                f.write(&world)?;
+            }
+        }
+        let done = match target {
+            Target::Time(d) => (world.time() - start) / d,
+            Target::Steps(n) => acc.steps() as f64 / n as f64,
+        };
+        progress.update(done, &world, &stats, wall);
+    }
+    progress.finish();
+    let summary = acc.summary(&scene.name, &world);
+    print_summary(&summary)
+        .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))?;
+    if summary.nan > 0 {
+        eprintln!(
+            "warning: {} particles have a non-finite position or velocity",
+            summary.nan
+        );
+    }
+    if let Some((mut file, path)) = stats_file {
+        let json = serde_json::to_string_pretty(&summary)
+            .map_err(|e| Failure::Runtime(format!("cannot encode statistics: {e}")))?;
+        writeln!(file, "{json}").map_err(|e| {
+            Failure::Runtime(format!("cannot write stats file {}: {e}", path.display()))
+        })?;
+    }
+    Ok(())
+}
+
+/// Applies the command-line overrides to `scene` and checks the result; errors name the option.
+fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure> {
+    let p = &mut scene.params;
+    if let Some(s) = args.solver {
+        p.solver = s.into();
+    }
+    if let Some(rho) = args.rho {
+        p.chebyshev.rho = rho;
+    }
+    if let Some(tau) = args.tau {
+        p.displacement_tolerance = tau;
+    }
+    if let Some(threads) = args.threads {
+        p.threads = threads;
+    }
+    if let Some(every) = args.every {
+        scene.output.every = every;
+    }
+    if let Some(dir) = &args.out {
+        scene.output.dir = Some(dir.clone());
+    }
+    if let Some(d) = args.duration {
+        scene.duration = d;
+    }
+    if args.steps == Some(0) {
+        return Err(Failure::Input(
+            Error::invalid("--steps", 0, "must be at least 1").to_string(),
+        ));
+    }
+    // Which scene key each option sets, to name the option in errors.
+    let options = [
+        ("solver.rho", "--rho", args.rho.is_some()),
+        ("solver.tau", "--tau", args.tau.is_some()),
+        ("threads", "--threads", args.threads.is_some()),
+        ("output.every", "--every", args.every.is_some()),
+        ("duration", "--duration", args.duration.is_some()),
+    ];
+    scene.validate().map_err(|e| {
+        let msg = e.to_string();
+        if let Error::InvalidArgument { field, .. } = &e {
+            for (key, option, given) in options {
+                if given && field == key {
+                    return Failure::Input(msg.replacen(key, option, 1));
+                }
+            }
+        }
+        Failure::Input(msg)
+    })?;
+    Ok(match args.steps {
+        Some(n) => Target::Steps(n),
+        None => Target::Time(scene.duration),
+    })
+}
+
+/// Writes numbered VTK frames into a directory.
+struct Frames {
+    dir: PathBuf,
+    every: usize,
+    written: usize,
+}
+
+impl Frames {
+    /// Creates `dir` if needed.
+    fn new(dir: &Path, every: usize) -> Result<Self, Failure> {
+        std::fs::create_dir_all(dir).map_err(|e| {
+            Failure::Runtime(format!(
+                "cannot create output directory {}: {e}",
+                dir.display()
+            ))
+        })?;
+        Ok(Self {
+            dir: dir.to_path_buf(),
+            every,
+            written: 0,
+        })
+    }
+
+    /// Writes the world's current state as the next frame.
+    fn write(&mut self, world: &World) -> Result<(), Failure> {
+        let path = self.dir.join(format!("frame_{:05}.vtk", self.written));
+        write_vtk(
+            &path,
+            &world.positions(),
+            &world.velocities(),
+            &world.densities(),
+        )
+        .map_err(|e| Failure::Runtime(e.to_string()))?;
+        self.written += 1;
+        Ok(())
+    }
+}
+
+/// Progress on stderr: a bar on a terminal, else a line about every 10 % of the run.
+struct Progress {
+    bar: Option<ProgressBar>,
+    next_tenth: u32,
+    steps: u64,
+    wall: f64,
+    outer: u64,
+}
+
+impl Progress {
+    fn new(target: Target) -> Self {
+        let bar = std::io::stderr().is_terminal().then(|| {
+            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+            let style = ProgressStyle::with_template(
+                "{bar:30.cyan/blue} {percent:>3}% {msg} [{elapsed_precise}, eta {eta}]",
+            )
+            .unwrap_or_else(|_| ProgressStyle::default_bar());
+            bar.set_style(style);
+            if let Target::Steps(n) = target {
+                bar.set_message(format!("0/{n} steps"));
+            }
+            bar
+        });
+        Self {
+            bar,
+            next_tenth: 1,
+            steps: 0,
+            wall: 0.0,
+            outer: 0,
+        }
+    }
+
+    /// Records a step that took `wall` seconds; `done` is the finished fraction of the run.
+    fn update(&mut self, done: f64, world: &World, step: &StepStats, wall: f64) {
+        self.steps += 1;
+        self.wall += wall;
+        self.outer += step.outer_iterations as u64;
+        let n = self.steps as f64;
+        let line = format!(
+            "t = {:.4} s, {} steps, {:.1} ms/step, {:.1} outer iterations/step",
+            world.time(),
+            self.steps,
+            self.wall * 1e3 / n,
+            self.outer as f64 / n
+        );
+        let done = done.clamp(0.0, 1.0);
+        match &self.bar {
+            Some(bar) => {
+                bar.set_position((done * 1000.0).round() as u64);
+                bar.set_message(line);
+            }
+            None => {
+                if done * 10.0 >= f64::from(self.next_tenth) - 1e-9 {
+                    eprintln!("{:>3.0}%  {line}", done * 100.0);
+                    while f64::from(self.next_tenth) <= done * 10.0 + 1e-9 {
+                        self.next_tenth += 1;
+                    }
+                }
+            }
+        }
+    }
+
+    fn finish(&self) {
+        if let Some(bar) = &self.bar {
+            bar.finish();
+        }
+    }
+}
+
+/// The human-readable summary on stdout.
+fn print_summary(s: &RunSummary) -> std::io::Result<()> {
+    let rows = [
+        ("scene", s.scene.clone()),
+        (
+            "solver",
+            format!("{} (rho {}, tau {:e} m)", s.solver, s.rho, s.tau),
+        ),
+        ("threads", s.threads.to_string()),
+        ("particles", s.particles.to_string()),
+        ("boundary particles", s.boundary_particles.to_string()),
+        ("steps", s.steps.to_string()),
+        ("simulated time", format!("{:.4} s", s.sim_time)),
+        (
+            "mean time per step",
+            format!("{:.2} ms", s.wall_ms_per_step),
+        ),
+        (
+            "mean outer iterations",
+            format!("{:.2}", s.outer_iterations_mean),
+        ),
+        (
+            "density error",
+            format!(
+                "avg {:.3} %, max {:.3} % (compression only)",
+                s.density_error_avg_percent, s.density_error_max_percent
+            ),
+        ),
+        ("escaped particles", s.escaped.to_string()),
+        ("NaN particles", s.nan.to_string()),
+    ];
+    let mut out = std::io::stdout().lock();
+    for (key, value) in rows {
+        writeln!(out, "{key:<22} {value}")?;
+    }
+    out.flush()
+}

@@ -1,0 +1,262 @@
+//! The `projfluid` command line: exit codes, error messages, statistics and frames.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// Runs the binary with `args`.
+fn projfluid(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_projfluid"))
+        .args(args)
+        .output()
+        .expect("the projfluid binary runs")
+}
+
+/// A fresh temporary directory for one test.
+fn temp_dir(test: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("projfluid-cli-{}-{test}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// A valid scene with one replacement applied to its text.
+fn scene_with(from: &str, to: &str) -> String {
+    let good = r#"{
+  "name": "cli_test",
+  "particle_radius": 0.05,
+  "container": {"min": [0, 0, 0], "max": [1, 1, 1]},
+  "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [3, 3, 3]}],
+  "duration": 0.01
+}"#;
+    assert!(good.contains(from), "{from}");
+    good.replace(from, to)
+}
+
+/// Asserts exit code 2 and a stderr starting with `error: ` that mentions every part.
+fn assert_bad_input(out: &Output, parts: &[&str]) {
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "stderr: {stderr}");
+    assert!(stderr.starts_with("error: "), "stderr: {stderr}");
+    for part in parts {
+        assert!(
+            stderr.contains(part),
+            "stderr {stderr:?} should mention {part:?}"
+        );
+    }
+}
+
+/// Writes `text` as a scene file and runs it for one step.
+fn run_scene_text(dir: &Path, file: &str, text: &str) -> Output {
+    let path = dir.join(file);
+    std::fs::write(&path, text).unwrap();
+    projfluid(&["run", path.to_str().unwrap(), "--steps", "1"])
+}
+
+#[test]
+fn bad_scene_files_exit_2_naming_field_and_value() {
+    let dir = temp_dir("bad-scenes");
+    let cases: [(&str, String, &[&str]); 5] = [
+        (
+            "missing.json",
+            scene_with(",\n  \"duration\": 0.01", ""),
+            &["missing.json", "missing field `duration`"],
+        ),
+        (
+            "negative.json",
+            scene_with("0.05", "-0.1"),
+            &["negative.json", "particle_radius", "-0.1"],
+        ),
+        (
+            "outside.json",
+            scene_with("[3, 3, 3]", "[3, 30, 3]"),
+            &[
+                "outside.json",
+                "fluid_blocks[0]",
+                "outside the container",
+                "max y 3.0",
+            ],
+        ),
+        (
+            "unknown.json",
+            scene_with("\"duration\"", "\"foo\": 1, \"duration\""),
+            &["unknown.json", "unknown field `foo`", "line 6"],
+        ),
+        (
+            "malformed.json",
+            scene_with("\"duration\": 0.01", "\"duration\" 0.01"),
+            &["malformed.json", "line 6", "column", "invalid JSON"],
+        ),
+    ];
+    for (file, text, parts) in cases {
+        assert_bad_input(&run_scene_text(&dir, file, &text), parts);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn missing_scenes_exit_2() {
+    let missing = std::env::temp_dir().join("projfluid-no-such-dir/scene.json");
+    let missing = missing.to_str().unwrap();
+    assert_bad_input(
+        &projfluid(&["run", missing, "--steps", "1"]),
+        &[missing, "does not exist"],
+    );
+    assert_bad_input(
+        &projfluid(&["run", "dam_break_huge", "--steps", "1"]),
+        &["dam_break_huge", "dam_break_small", "dam_break_30k"],
+    );
+}
+
+#[test]
+fn bad_option_values_exit_2_naming_option_and_value() {
+    let cases: [(&[&str], &[&str]); 6] = [
+        (&["--rho", "1.5"], &["--rho", "1.5"]),
+        (&["--tau", "-1"], &["--tau", "-1"]),
+        (&["--every", "0"], &["--every", "0"]),
+        (&["--steps", "0"], &["--steps", "0"]),
+        (&["--duration", "-2"], &["--duration", "-2"]),
+        (&["--solver", "sor"], &["--solver", "sor"]),
+    ];
+    for (options, parts) in cases {
+        let mut args = vec!["run", "dam_break_small"];
+        args.extend_from_slice(options);
+        assert_bad_input(&projfluid(&args), parts);
+    }
+}
+
+#[test]
+fn steps_and_duration_are_exclusive() {
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--duration",
+        "0.1",
+    ]);
+    assert_bad_input(&out, &["--steps", "--duration"]);
+}
+
+#[test]
+fn short_run_writes_stats_and_frames() {
+    let dir = temp_dir("good-run");
+    let stats = dir.join("stats.json");
+    let frames = dir.join("frames");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "3",
+        "--threads",
+        "2",
+        "--stats",
+        stats.to_str().unwrap(),
+        "--out",
+        frames.to_str().unwrap(),
+        "--every",
+        "1",
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "stderr: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for row in ["dam_break_small", "chebyshev", "3840", "escaped", "NaN"] {
+        assert!(
+            stdout.contains(row),
+            "summary {stdout:?} should mention {row:?}"
+        );
+    }
+
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    let keys = [
+        "scene",
+        "solver",
+        "rho",
+        "tau",
+        "threads",
+        "particles",
+        "boundary_particles",
+        "steps",
+        "sim_time",
+        "wall_ms_per_step",
+        "outer_iterations_mean",
+        "density_error_avg_percent",
+        "density_error_max_percent",
+        "escaped",
+        "nan",
+        "positions_hash",
+        "ms_per_step_breakdown",
+    ];
+    for key in keys {
+        assert!(json.get(key).is_some(), "stats lack {key}: {json}");
+    }
+    assert_eq!(json["scene"], "dam_break_small");
+    assert_eq!(json["solver"], "chebyshev");
+    assert_eq!(json["particles"], 3840);
+    assert_eq!(json["steps"], 3);
+    assert_eq!(json["threads"], 2);
+    assert_eq!(json["nan"], 0);
+
+    let mut names: Vec<String> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        [
+            "frame_00000.vtk",
+            "frame_00001.vtk",
+            "frame_00002.vtk",
+            "frame_00003.vtk"
+        ]
+    );
+    let last = std::fs::read(frames.join("frame_00003.vtk")).unwrap();
+    assert!(last.starts_with(b"# vtk DataFile Version 3.0\n"));
+    assert!(
+        last.windows(b"POINTS 3840 float".len())
+            .any(|w| w == b"POINTS 3840 float")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn unwritable_output_exits_1() {
+    let dir = temp_dir("unwritable");
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "not a directory").unwrap();
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "1",
+        "--out",
+        blocker.join("frames").to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.starts_with("error: ") && stderr.contains("frames"),
+        "{stderr}"
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn scenes_lists_builtins_with_particle_counts() {
+    let out = projfluid(&["scenes"]);
+    assert_eq!(out.status.code(), Some(0));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        stdout.contains("dam_break_small") && stdout.contains("3840"),
+        "{stdout}"
+    );
+    assert!(
+        stdout.contains("dam_break_30k") && stdout.contains("30000"),
+        "{stdout}"
+    );
+}

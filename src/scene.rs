@@ -539,6 +539,24 @@ mod tests {
     }
 
     #[test]
+    fn documented_example_is_valid() {
+        let doc = include_str!("../docs/scene-format.md");
+        let example = doc
+            .split("```json\n")
+            .nth(1)
+            .and_then(|rest| rest.split("```").next())
+            .expect("docs/scene-format.md has a json example");
+        let scene = Scene::from_json(example).unwrap();
+        let mut expected = Scene::builtin("dam_break_small").unwrap();
+        expected.description = scene.description.clone();
+        expected.output = OutputSpec {
+            dir: Some(PathBuf::from("frames")),
+            every: 20,
+        };
+        assert_eq!(scene, expected);
+    }
+
+    #[test]
     fn trailing_garbage_is_an_error() {
         let msg = message(Scene::from_json(&format!("{GOOD} x")));
         assert_names(&msg, &["line 10", "trailing"]);

@@ -211,6 +211,16 @@ impl Params {
                 ));
             }
         }
+        let mass = self.particle_mass();
+        if !(mass.is_finite() && mass > 0.0) {
+            return Err(Error::invalid(
+                "particle_radius",
+                self.particle_radius,
+                &format!(
+                    "gives a particle mass of {mass} kg with this rest density and mass factor; it must be positive and finite"
+                ),
+            ));
+        }
         for (axis, g) in self.gravity.iter().enumerate() {
             if !g.is_finite() {
                 return Err(Error::invalid(

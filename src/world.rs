@@ -180,6 +180,13 @@ impl World {
     /// Adds static boundary particles at `positions` (m).
     pub fn add_boundary_particles(&mut self, positions: &[Vec3]) -> Result<(), Error> {
         check_finite("positions", positions)?;
+        if self.boundary.positions.len() + positions.len() > MAX_PARTICLES {
+            return Err(Error::invalid(
+                "positions",
+                positions.len(),
+                "would exceed the boundary particle limit",
+            ));
+        }
         self.boundary.positions.extend_from_slice(positions);
         self.boundary.dirty = true;
         Ok(())
@@ -210,6 +217,14 @@ impl World {
                 "container",
                 format!("{:?}", size.as_slice()),
                 "is too large for the particle radius",
+            ));
+        }
+        let expected = box_wall_sample_count(&container, r, layers);
+        if expected + self.boundary.positions.len() as f64 > MAX_PARTICLES as f64 {
+            return Err(Error::invalid(
+                "container",
+                format!("{:?}", size.as_slice()),
+                &format!("needs about {expected:.3e} boundary particles, more than the limit"),
             ));
         }
         let samples = sample_box_walls(&container, r, layers);
@@ -420,5 +435,81 @@ fn check_finite(field: &str, values: &[Vec3]) -> Result<(), Error> {
             "must be finite",
         )),
         None => Ok(()),
+    }
+}
+
+/// Most particles of one kind (fluid or boundary) a world holds; indices must fit in u32 with room.
+const MAX_PARTICLES: usize = u32::MAX as usize / 64;
+
+/// The number of samples [`sample_box_walls`] makes for `container` (computed in f64, so that
+/// absurd boxes are rejected before anything is allocated).
+fn box_wall_sample_count(container: &Aabb, spacing: f64, layers: usize) -> f64 {
+    (0..layers)
+        .map(|layer| {
+            let extent = container.max - container.min + Vec3::repeat(2.0 * layer as f64 * spacing);
+            let n = extent.map(|e| (e / spacing).ceil().max(1.0));
+            let outer = (n.x + 1.0) * (n.y + 1.0) * (n.z + 1.0);
+            let inner = (n.x - 1.0) * (n.y - 1.0) * (n.z - 1.0);
+            outer - inner
+        })
+        .sum()
+}
+
+/// Support for embedders such as the C API: fallible reservation and copies into caller buffers.
+impl World {
+    /// Reserves room for `additional` more fluid particles in every per-particle array, so that
+    /// a following add does not fail to allocate. Changes nothing observable.
+    /// Errors when the memory cannot be had; the world stays usable.
+    pub fn try_reserve_fluid(
+        &mut self,
+        additional: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        let f = &mut self.fluid;
+        f.positions.try_reserve(additional)?;
+        f.velocities.try_reserve(additional)?;
+        f.densities.try_reserve(additional)?;
+        f.ids.try_reserve(additional)
+    }
+
+    /// Reserves room for `additional` more boundary particles (see [`World::try_reserve_fluid`]).
+    pub fn try_reserve_boundary(
+        &mut self,
+        additional: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        self.boundary.positions.try_reserve(additional)
+    }
+
+    /// Writes fluid positions (m) as x, y, z triples of `f32` into `out[..3·fluid_count()]`, in
+    /// the order the particles were added, without allocating. Returns the number of floats
+    /// needed as the error, leaving `out` untouched, when `out` is too short.
+    pub fn write_positions_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        self.write_vectors_f32(&self.fluid.positions, out)
+    }
+
+    /// Writes fluid velocities (m/s) like [`World::write_positions_f32`].
+    pub fn write_velocities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        self.write_vectors_f32(&self.fluid.velocities, out)
+    }
+
+    /// Writes fluid densities (kg/m³, zero before the first step) into
+    /// `out[..fluid_count()]` in the order the particles were added; errs with the number of
+    /// floats needed, leaving `out` untouched, when `out` is too short.
+    pub fn write_densities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        let n = self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        for (&rho, &id) in self.fluid.densities.iter().zip(&self.fluid.ids) {
+            out[id as usize] = rho as f32;
+        }
+        Ok(())
+    }
+
+    fn write_vectors_f32(&self, values: &[Vec3], out: &mut [f32]) -> Result<(), usize> {
+        let n = 3 * self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        for (v, &id) in values.iter().zip(&self.fluid.ids) {
+            let i = 3 * id as usize;
+            out[i..i + 3].copy_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
+        }
+        Ok(())
     }
 }

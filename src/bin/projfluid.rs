@@ -178,6 +178,17 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
     if let Some(f) = frames.as_mut() {
         f.write(&world)?;
     }
+    let goal = match target {
+        Target::Time(d) => format!("{d} s simulated"),
+        Target::Steps(n) => format!("{n} steps"),
+    };
+    eprintln!(
+        "{}: {} particles, {} boundary particles, {} solver, {goal}",
+        scene.name,
+        world.fluid_count(),
+        world.boundary_count(),
+        scene.params.solver.name()
+    );
     let mut acc = RunAccumulator::default();
     let mut progress = Progress::new(target);
     let (start, end) = (world.time(), world.time() + scene.duration);
@@ -337,7 +348,7 @@ impl Progress {
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             let style = ProgressStyle::with_template(
-                "{bar:30.cyan/blue} {percent:>3}% {msg} [{elapsed_precise}, eta {eta}]",
+                "{bar:20.cyan/blue} {percent:>3}% {elapsed:>4} {wide_msg}",
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar());
             bar.set_style(style);
@@ -361,27 +372,27 @@ impl Progress {
         self.wall += wall;
         self.outer += step.outer_iterations as u64;
         let n = self.steps as f64;
-        let line = format!(
-            "t = {:.4} s, {} steps, {:.1} ms/step, {:.1} outer iterations/step",
-            world.time(),
-            self.steps,
-            self.wall * 1e3 / n,
-            self.outer as f64 / n
-        );
+        let (t, ms, outer) = (world.time(), self.wall * 1e3 / n, self.outer as f64 / n);
         let done = done.clamp(0.0, 1.0);
         match &self.bar {
             Some(bar) => {
                 bar.set_position((done * 1000.0).round() as u64);
-                bar.set_message(line);
+                bar.set_message(format!(
+                    "t={t:.3}s step {} {ms:.1} ms/step {outer:.1} outer it.",
+                    self.steps
+                ));
             }
-            None => {
-                if done * 10.0 >= f64::from(self.next_tenth) - 1e-9 {
-                    eprintln!("{:>3.0}%  {line}", done * 100.0);
-                    while f64::from(self.next_tenth) <= done * 10.0 + 1e-9 {
-                        self.next_tenth += 1;
-                    }
+            None if done * 10.0 >= f64::from(self.next_tenth) - 1e-9 => {
+                eprintln!(
+                    "{:>3.0}%  t = {t:.4} s, step {}, {ms:.1} ms/step, {outer:.1} outer iterations/step",
+                    done * 100.0,
+                    self.steps
+                );
+                while f64::from(self.next_tenth) <= done * 10.0 + 1e-9 {
+                    self.next_tenth += 1;
                 }
             }
+            None => {}
         }
     }
 

@@ -1,0 +1,240 @@
+//! `PfParams`, the C mirror of [`Params`], with its enums and `pf_params_default`.
+
+use super::status::{Failure, PfStatus, status_call};
+use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+use std::ffi::c_int;
+use std::ptr;
+
+/// The global solver run in each outer iteration.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(non_camel_case_types)]
+pub enum PfSolver {
+    /// One Jacobi sweep plus Chebyshev extrapolation over the outer iterations (the default).
+    PF_SOLVER_CHEBYSHEV = 0,
+    /// Exactly one Jacobi sweep per outer iteration.
+    PF_SOLVER_JACOBI1 = 1,
+    /// Jacobi sweeps until the residual drops by 1e-10 or 100 sweeps.
+    PF_SOLVER_JACOBI = 2,
+}
+
+/// How the first Chebyshev weight ω₂ is chosen.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(non_camel_case_types)]
+pub enum PfOmega2Rule {
+    /// ω₂ = 2/(2 − ρ²) (the default).
+    PF_OMEGA2_CHEBYSHEV = 0,
+    /// ω₂ = 4/(4 − ρ²).
+    PF_OMEGA2_SEED = 1,
+}
+
+/// Weight of a particle's share of a local projection.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(non_camel_case_types)]
+pub enum PfProjectionWeight {
+    /// w = fluid neighbour count + 1 (the default).
+    PF_WEIGHT_NEIGHBOR_COUNT = 0,
+    /// w = 1.
+    PF_WEIGHT_UNIT = 1,
+}
+
+// Enum fields are read from C memory as plain ints before they are checked.
+const _: () = assert!(size_of::<PfSolver>() == size_of::<c_int>());
+const _: () = assert!(size_of::<PfOmega2Rule>() == size_of::<c_int>());
+const _: () = assert!(size_of::<PfProjectionWeight>() == size_of::<c_int>());
+
+/// Every setting of a world (SI units: metres, seconds, kilograms). Fill it with
+/// `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
+/// validates it. The struct is plain data owned by the caller; the library copies it.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PfParams {
+    /// Particle radius r (m); lattice spacing 2r, support radius 4r. Default 0.025.
+    pub particle_radius: f64,
+    /// Rest density ρ0 (kg/m³). Default 1000.
+    pub rest_density: f64,
+    /// Particle mass as a fraction of ρ0·(2r)³. Default 0.8.
+    pub mass_factor: f64,
+    /// Constraint stiffness k (N/m). Default 5e4.
+    pub stiffness: f64,
+    /// Gravitational acceleration (m/s²). Default (0, −9.81, 0).
+    pub gravity: [f64; 3],
+    /// The global solver. Default `PF_SOLVER_CHEBYSHEV`.
+    pub solver: PfSolver,
+    /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_CHEBYSHEV`.
+    pub omega2_rule: PfOmega2Rule,
+    /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.9.
+    pub chebyshev_rho: f64,
+    /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 3.
+    pub chebyshev_delay: u32,
+    /// Under-relaxation γ of the Chebyshev step, in (0, 1]. Default 1.
+    pub chebyshev_gamma: f64,
+    /// Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
+    pub projection_weight: PfProjectionWeight,
+    /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
+    /// outer iteration. Default 1e-3·r.
+    pub displacement_tolerance: f64,
+    /// Smallest number of outer iterations per step (≥ 1). Default 1.
+    pub min_outer_iterations: u32,
+    /// Largest number of outer iterations per step (≤ 100000). Default 100.
+    pub max_outer_iterations: u32,
+    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.5.
+    pub cfl_factor: f64,
+    /// Smallest CFL step (s). Default 1e-4.
+    pub dt_min: f64,
+    /// Largest CFL step (s). Default 5e-3.
+    pub dt_max: f64,
+    /// CFL step size of the first step (s). Default 1e-3.
+    pub dt_initial: f64,
+    /// XSPH viscosity coefficient in [0, 1] (0 = off). Default 0.01.
+    pub viscosity: f64,
+    /// Worker threads of the world's own thread pool (0 = one per core, at most 1024).
+    /// Default 0.
+    pub threads: u32,
+}
+
+impl From<&Params> for PfParams {
+    fn from(p: &Params) -> Self {
+        let small = |n: usize| u32::try_from(n).unwrap_or(u32::MAX);
+        Self {
+            particle_radius: p.particle_radius,
+            rest_density: p.rest_density,
+            mass_factor: p.mass_factor,
+            stiffness: p.stiffness,
+            gravity: p.gravity,
+            solver: match p.solver {
+                SolverKind::Chebyshev => PfSolver::PF_SOLVER_CHEBYSHEV,
+                SolverKind::Jacobi1 => PfSolver::PF_SOLVER_JACOBI1,
+                SolverKind::Jacobi => PfSolver::PF_SOLVER_JACOBI,
+            },
+            omega2_rule: match p.chebyshev.omega2_rule {
+                Omega2Rule::Chebyshev => PfOmega2Rule::PF_OMEGA2_CHEBYSHEV,
+                Omega2Rule::SeedLiteral => PfOmega2Rule::PF_OMEGA2_SEED,
+            },
+            chebyshev_rho: p.chebyshev.rho,
+            chebyshev_delay: small(p.chebyshev.delay),
+            chebyshev_gamma: p.chebyshev.gamma,
+            projection_weight: match p.projection_weight {
+                ProjectionWeight::NeighborCount => PfProjectionWeight::PF_WEIGHT_NEIGHBOR_COUNT,
+                ProjectionWeight::Unit => PfProjectionWeight::PF_WEIGHT_UNIT,
+            },
+            displacement_tolerance: p.displacement_tolerance,
+            min_outer_iterations: small(p.min_outer_iterations),
+            max_outer_iterations: small(p.max_outer_iterations),
+            cfl_factor: p.cfl_factor,
+            dt_min: p.dt_min,
+            dt_max: p.dt_max,
+            dt_initial: p.dt_initial,
+            viscosity: p.viscosity,
+            threads: small(p.threads),
+        }
+    }
+}
+
+/// Reads `*raw` into validated [`Params`]. Enum fields are read as ints and checked first,
+/// so any bit pattern the caller stored is handled without undefined behaviour.
+///
+/// # Safety
+/// `raw` must be non-NULL, aligned and point to `size_of::<PfParams>()` readable bytes.
+pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure> {
+    macro_rules! field {
+        ($name:ident) => {
+            // SAFETY: the caller guarantees `raw` points to a readable PfParams.
+            unsafe { ptr::addr_of!((*raw).$name).read() }
+        };
+    }
+    macro_rules! code {
+        ($name:ident) => {
+            // SAFETY: as above; the field is read as the int it is in C, not as a Rust enum.
+            unsafe { ptr::addr_of!((*raw).$name).cast::<c_int>().read() }
+        };
+    }
+    let solver = match code!(solver) {
+        0 => SolverKind::Chebyshev,
+        1 => SolverKind::Jacobi1,
+        2 => SolverKind::Jacobi,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->solver must be a PfSolver, got {n}"
+            )));
+        }
+    };
+    let omega2_rule = match code!(omega2_rule) {
+        0 => Omega2Rule::Chebyshev,
+        1 => Omega2Rule::SeedLiteral,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->omega2_rule must be a PfOmega2Rule, got {n}"
+            )));
+        }
+    };
+    let projection_weight = match code!(projection_weight) {
+        0 => ProjectionWeight::NeighborCount,
+        1 => ProjectionWeight::Unit,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->projection_weight must be a PfProjectionWeight, got {n}"
+            )));
+        }
+    };
+    let count = |n: u32| n as usize;
+    let params = Params {
+        particle_radius: field!(particle_radius),
+        rest_density: field!(rest_density),
+        mass_factor: field!(mass_factor),
+        stiffness: field!(stiffness),
+        gravity: field!(gravity),
+        solver,
+        chebyshev: ChebyshevParams {
+            rho: field!(chebyshev_rho),
+            delay: count(field!(chebyshev_delay)),
+            omega2_rule,
+            gamma: field!(chebyshev_gamma),
+        },
+        displacement_tolerance: field!(displacement_tolerance),
+        min_outer_iterations: count(field!(min_outer_iterations)),
+        max_outer_iterations: count(field!(max_outer_iterations)),
+        projection_weight,
+        cfl_factor: field!(cfl_factor),
+        dt_min: field!(dt_min),
+        dt_max: field!(dt_max),
+        dt_initial: field!(dt_initial),
+        viscosity: field!(viscosity),
+        threads: count(field!(threads)),
+    };
+    params
+        .validate()
+        .map_err(|e| Failure::invalid(format!("params->{e}")))?;
+    Ok(params)
+}
+
+/// Fills `*out` with the default parameters (particle radius 0.025 m, water, Chebyshev
+/// solver; see each field). Returns `PF_ERROR_NULL_POINTER` when `out` is NULL.
+///
+/// # Safety
+/// `out` must be NULL or point to a writable `PfParams`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
+    status_call("pf_params_default", || {
+        let out = super::checked_mut_ptr(out, "out")?;
+        // SAFETY: `out` is non-NULL and aligned; the caller guarantees it is writable.
+        unsafe { out.write(PfParams::from(&Params::default())) };
+        Ok(())
+    })
+}
+
+/// Checks `*params` without creating a world: `PF_OK` when `pf_world_create` would accept it,
+/// otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field.
+///
+/// # Safety
+/// `params` must be NULL or point to a readable `PfParams`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_params_validate(params: *const PfParams) -> PfStatus {
+    status_call("pf_params_validate", || {
+        let params = super::checked_ptr(params, "params")?;
+        // SAFETY: checked non-NULL and aligned; the caller guarantees it is readable.
+        unsafe { read_params(params) }.map(drop)
+    })
+}

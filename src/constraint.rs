@@ -3,7 +3,7 @@
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;
-use crate::neighbors::{NeighborLists, par_segments_mut};
+use crate::neighbors::{NeighborLists, par_segments_zip_mut};
 use crate::params::ProjectionWeight;
 use rayon::prelude::*;
 
@@ -61,6 +61,26 @@ pub struct DensityConstraint {
     pub rest_density: f64,
     /// Weighting of the projection.
     pub weight: ProjectionWeight,
+    /// Write every projection's corrections out, as multi-step ones do (the reference path,
+    /// for tests of the single-step shortcut).
+    pub materialize_all: bool,
+}
+
+/// What the local step of one constraint produced.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Projection {
+    /// λ of a projection that ended after one step (0 for an inactive constraint), in m²…
+    /// units of C/|∇C|², i.e. m².
+    pub lambda: f64,
+    /// The correction of the constraint's own particle, P_{i,i} − x_i (m).
+    pub self_correction: Vec3,
+    /// The neighbours' corrections were written to the stencil buffer (multi-step projection).
+    pub materialized: bool,
+}
+
+thread_local! {
+    /// Per-thread buffer for the gradients of one stencil.
+    static SCRATCH: std::cell::RefCell<Vec<Vec3>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 impl DensityConstraint {
@@ -107,67 +127,149 @@ impl DensityConstraint {
         }
     }
 
-    /// The local step: projects every constraint i at the iterate `x`, writing the stencil
-    /// corrections P_{i,j} − x_j (m) into `corrections` (layout of [`Neighborhood::stencil_start`]).
-    pub fn project(&self, x: &[Vec3], nb: &Neighborhood, corrections: &mut Vec<Vec3>) {
+    /// The local step: projects every constraint i at the iterate `x`. Single-step projections
+    /// (the usual case) keep only λ_i; longer ones write their stencil corrections
+    /// P_{i,j} − x_j (m) into `corrections` (layout of [`Neighborhood::stencil_start`]).
+    pub fn project(
+        &self,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        projections: &mut Vec<Projection>,
+        corrections: &mut Vec<Vec3>,
+    ) {
+        projections.resize(x.len(), Projection::default());
         corrections.resize(nb.stencil_len(), Vec3::zeros());
-        par_segments_mut(nb.stencil_offsets, corrections, |i, dp| {
-            self.project_one(i, x, nb, dp)
-        });
+        par_segments_zip_mut(
+            nb.stencil_offsets,
+            corrections,
+            projections,
+            |i, dp, out| {
+                SCRATCH.with_borrow_mut(|scratch| self.project_one(i, x, nb, dp, out, scratch))
+            },
+        );
+    }
+
+    /// Σ_{i: j∈N̄_j} (P_{i,j} − x_j): the sum of all corrections the local step made to
+    /// particle j's position (m), gathered from its own and its neighbours' projections.
+    #[inline]
+    pub fn gathered_correction(
+        &self,
+        j: usize,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        projections: &[Projection],
+        corrections: &[Vec3],
+        gather_slots: &[u32],
+    ) -> Vec3 {
+        let scale = self.weight_of(nb, j) * self.mass / self.rest_density;
+        let first = nb.fluid.offsets[j] as usize;
+        let mut sum = projections[j].self_correction;
+        for (k, &i) in nb.fluid.of(j).iter().enumerate() {
+            let p = &projections[i as usize];
+            if p.materialized {
+                sum += corrections[gather_slots[first + k] as usize];
+            } else if p.lambda != 0.0 {
+                // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).
+                sum += self.kernel.grad_w(&(x[j] - x[i as usize])) * (p.lambda * scale);
+            }
+        }
+        sum
+    }
+
+    /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary
+    /// particles are not unknowns); `grads[s]` receives ∇_{p_j} C_i = −(m/ρ0)∇W(p_i − p_j)
+    /// for the s-th fluid neighbour at `neighbor(s)`.
+    fn gradients(
+        &self,
+        i: usize,
+        pi: Vec3,
+        neighbor: impl Fn(usize) -> Vec3,
+        nb: &Neighborhood,
+        grads: &mut Vec<Vec3>,
+    ) -> (Vec3, f64) {
+        let kernel = &self.kernel;
+        let scale = self.mass / self.rest_density;
+        let mut grad_i: Vec3 = nb
+            .boundary
+            .of(i)
+            .iter()
+            .map(|&b| {
+                let b = b as usize;
+                kernel.grad_w(&(pi - nb.boundary_positions[b])) * nb.boundary_psi[b]
+            })
+            .sum::<Vec3>()
+            / self.rest_density;
+        let mut denominator = 0.0;
+        grads.clear();
+        for s in 0..nb.fluid.count(i) {
+            let g = kernel.grad_w(&(pi - neighbor(s))) * scale;
+            grad_i += g;
+            denominator += g.norm_squared();
+            grads.push(-g);
+        }
+        (grad_i, denominator + grad_i.norm_squared())
     }
 
     /// Projection of constraint i (ALGORITHM.md §2.5): Newton-like steps on a private copy
-    /// p = x + dp of the stencil until C_i(p) ≤ 1e-14. `dp[0]` belongs to i, `dp[s + 1]` to
-    /// its s-th fluid neighbour.
-    fn project_one(&self, i: usize, x: &[Vec3], nb: &Neighborhood, dp: &mut [Vec3]) {
-        dp.fill(Vec3::zeros());
+    /// p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after its first
+    /// step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour)
+    /// receive the corrections.
+    fn project_one(
+        &self,
+        i: usize,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        dp: &mut [Vec3],
+        out: &mut Projection,
+        grads: &mut Vec<Vec3>,
+    ) {
+        *out = Projection::default();
         let members = nb.fluid.of(i);
-        let kernel = &self.kernel;
-        let scale = self.mass / self.rest_density;
+        let at = |s: usize| x[members[s] as usize];
+        let w = |s: usize| self.weight_of(nb, members[s] as usize);
+        let mut materialized = false;
         for step in 0..MAX_PROJECTION_STEPS {
-            let pi = x[i] + dp[0];
-            let rho = self.density_at(i, pi, |s| x[members[s] as usize] + dp[s + 1], nb);
-            let c = (rho / self.rest_density - 1.0).max(0.0);
-            if c <= CONSTRAINT_GOAL {
-                return;
-            }
-            // ∇_{p_j} C_i = −(m/ρ0)∇W(p_i − p_j); ∇_{p_i} C_i collects the fluid and boundary terms.
-            let mut grad_i: Vec3 = nb
-                .boundary
-                .of(i)
-                .iter()
-                .map(|&b| {
-                    let b = b as usize;
-                    kernel.grad_w(&(pi - nb.boundary_positions[b])) * nb.boundary_psi[b]
-                })
-                .sum::<Vec3>()
-                / self.rest_density;
-            let mut denominator = 0.0;
-            for s in 0..members.len() {
-                let g = kernel.grad_w(&(pi - (x[members[s] as usize] + dp[s + 1]))) * scale;
-                grad_i += g;
-                denominator += g.norm_squared();
-                if step == 0 {
-                    // dp is zero on the first step: keep −g there until λ is known.
-                    dp[s + 1] = -g;
+            let pi = x[i] + out.self_correction;
+            let rho = match (step, materialized) {
+                (0, _) => self.density_at(i, pi, at, nb),
+                (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
+                // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
+                (_, false) => {
+                    let lambda = out.lambda;
+                    self.density_at(i, pi, |s| at(s) + grads[s] * (lambda * w(s)), nb)
                 }
+            };
+            let c = (rho / self.rest_density - 1.0).max(0.0);
+            if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
+                // A second step is needed (or requested): write the first step's corrections out.
+                dp[0] = out.self_correction;
+                for (s, g) in grads.iter().enumerate() {
+                    dp[s + 1] = g * (out.lambda * w(s));
+                }
+                materialized = true;
             }
-            denominator += grad_i.norm_squared();
+            if c <= CONSTRAINT_GOAL {
+                break;
+            }
+            let (grad_i, denominator) = if materialized {
+                self.gradients(i, pi, |s| at(s) + dp[s + 1], nb, grads)
+            } else {
+                self.gradients(i, pi, at, nb, grads)
+            };
             if denominator == 0.0 {
-                return;
+                break;
             }
             let lambda = -c / (denominator + REGULARIZATION);
-            for s in 0..members.len() {
-                let j = members[s] as usize;
-                let g = if step == 0 {
-                    dp[s + 1]
-                } else {
-                    -kernel.grad_w(&(pi - (x[j] + dp[s + 1]))) * scale
-                };
-                let delta = g * (lambda * self.weight_of(nb, j));
-                dp[s + 1] = if step == 0 { delta } else { dp[s + 1] + delta };
+            out.self_correction += grad_i * (lambda * self.weight_of(nb, i));
+            if materialized {
+                for (s, g) in grads.iter().enumerate() {
+                    dp[s + 1] += g * (lambda * w(s));
+                }
+                dp[0] = out.self_correction;
+            } else {
+                out.lambda = lambda;
             }
-            dp[0] += grad_i * (lambda * self.weight_of(nb, i));
         }
+        out.materialized = materialized;
     }
 }

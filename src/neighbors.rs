@@ -265,20 +265,36 @@ pub fn par_segments_mut<T: Send>(
     data: &mut [T],
     f: impl Fn(usize, &mut [T]) + Sync,
 ) {
+    let mut unit = vec![(); offsets.len().saturating_sub(1)];
+    par_segments_zip_mut(offsets, data, &mut unit, |i, segment, _| f(i, segment));
+}
+
+/// Runs `f(i, segment_i, &mut items[i])` in parallel over the CSR segments
+/// `data[offsets[i]..offsets[i + 1]]` together with one item per segment.
+pub fn par_segments_zip_mut<T: Send, U: Send>(
+    offsets: &[u32],
+    data: &mut [T],
+    items: &mut [U],
+    f: impl Fn(usize, &mut [T], &mut U) + Sync,
+) {
     let n = offsets.len().saturating_sub(1);
+    assert_eq!(items.len(), n, "one item per segment");
     let mut pieces = Vec::with_capacity(n.div_ceil(BLOCK));
-    let mut rest = data;
+    let (mut rest, mut rest_items) = (data, items);
     for b in 0..n.div_ceil(BLOCK) {
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
         let (head, tail) = rest.split_at_mut((offsets[hi] - offsets[lo]) as usize);
-        pieces.push((lo, hi, head));
+        let (head_items, tail_items) = rest_items.split_at_mut(hi - lo);
+        pieces.push((lo, head, head_items));
         rest = tail;
+        rest_items = tail_items;
     }
-    pieces.into_par_iter().for_each(|(lo, hi, chunk)| {
+    pieces.into_par_iter().for_each(|(lo, chunk, chunk_items)| {
         let base = offsets[lo] as usize;
-        for i in lo..hi {
+        for (k, item) in chunk_items.iter_mut().enumerate() {
+            let i = lo + k;
             let (a, b) = (offsets[i] as usize - base, offsets[i + 1] as usize - base);
-            f(i, &mut chunk[a..b]);
+            f(i, &mut chunk[a..b], item);
         }
     });
 }

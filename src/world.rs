@@ -69,6 +69,7 @@ impl World {
                 mass: params.particle_mass(),
                 rest_density: params.rest_density,
                 weight: params.projection_weight,
+                materialize_all: false,
             },
             pool,
             fluid: Fluid::default(),

@@ -335,7 +335,7 @@ enum PfStatus pf_world_create(const struct PfParams *params,
                               struct PfWorld **out);
 
 /**
- * Frees a world and everything it owns (its worker threads finish in the background).
+ * Frees a world and everything it owns, waiting for its worker threads to exit.
  * NULL is a no-op. The handle must not be used afterwards, nor be in use by another
  * thread during the call.
  *

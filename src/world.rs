@@ -63,6 +63,14 @@ impl World {
             .map_err(|e| {
                 Error::invalid("threads", params.threads, &format!("could not start: {e}"))
             })?;
+        Self::with_pool(params, pool)
+    }
+
+    /// An empty world with the given parameters (validated) that runs on `pool`, which the
+    /// caller built (e.g. to join its threads after dropping the world, as the C API does).
+    /// `params.threads` is kept as given; the pool's own size decides the parallelism.
+    pub fn with_pool(params: Params, pool: rayon::ThreadPool) -> Result<Self, Error> {
+        params.validate()?;
         Ok(Self {
             constraint: DensityConstraint {
                 kernel: CubicKernel::new(params.support_radius()),

@@ -4,10 +4,12 @@
 use super::params::{PfParams, read_params};
 use super::status::{Failure, PfStatus, status_call};
 use super::{checked_mut_ptr, checked_ptr, input_slice, output_slice};
+use crate::Params;
 use crate::boundary::Aabb;
 use crate::{Vec3, World};
 use std::ffi::{c_char, c_uint};
-use std::sync::{Mutex, MutexGuard, TryLockError};
+use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
+use std::thread::JoinHandle;
 
 /// Most particles one call may add (the world's own limit; indices must fit in 32 bits).
 const MAX_PARTICLES_PER_CALL: usize = u32::MAX as usize / 64;
@@ -20,6 +22,63 @@ const MAX_PARTICLES_PER_CALL: usize = u32::MAX as usize / 64;
 /// Distinct worlds are independent and may be stepped in parallel.
 pub struct PfWorld {
     world: Mutex<World>,
+    /// The world's worker threads, joined by `pf_world_destroy` so that none outlives it.
+    threads: Vec<JoinHandle<()>>,
+}
+
+impl PfWorld {
+    /// A world on a thread pool of `params.threads` workers whose threads can be joined.
+    fn new(params: Params) -> Result<Self, Failure> {
+        let handles = Arc::new(Mutex::new(Vec::new()));
+        let spawned = Arc::clone(&handles);
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(params.threads)
+            .thread_name(|i| format!("projfluid-{i}"))
+            .spawn_handler(move |thread| {
+                let mut builder = std::thread::Builder::new();
+                if let Some(name) = thread.name() {
+                    builder = builder.name(name.to_string());
+                }
+                let handle = builder.spawn(|| thread.run())?;
+                spawned
+                    .lock()
+                    .unwrap_or_else(PoisonError::into_inner)
+                    .push(handle);
+                Ok(())
+            })
+            .build();
+        let world = pool
+            .map_err(|e| {
+                Failure::invalid(format!(
+                    "params->threads = {}: could not start the worker threads: {e}",
+                    params.threads
+                ))
+            })
+            .and_then(|pool| World::with_pool(params, pool).map_err(Failure::from));
+        let threads = std::mem::take(&mut *handles.lock().unwrap_or_else(PoisonError::into_inner));
+        match world {
+            Ok(world) => Ok(Self {
+                world: Mutex::new(world),
+                threads,
+            }),
+            Err(failure) => {
+                // The pool is gone already; wait for whatever threads it had started.
+                threads.into_iter().for_each(|h| drop(h.join()));
+                Err(failure)
+            }
+        }
+    }
+
+    /// Drops the world, which tells its pool to stop, then waits for every worker to exit,
+    /// so that no library code runs after `pf_world_destroy` returns.
+    fn shutdown(self) {
+        let Self { world, threads } = self;
+        drop(world);
+        for handle in threads {
+            // A worker that panicked has exited too; there is nothing left to report to.
+            let _ = handle.join();
+        }
+    }
 }
 
 // The handle crosses threads in C; keep that sound.
@@ -117,6 +176,28 @@ unsafe fn read_vec3(p: *const f32, what: &str) -> Result<Vec3, Failure> {
     Ok(Vec3::new(v[0].into(), v[1].into(), v[2].into()))
 }
 
+/// Rejects a non-finite 3-vector argument, naming it.
+fn check_finite(v: Vec3, what: &str) -> Result<Vec3, Failure> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err(Failure::invalid(format!(
+            "{what} must be finite, got {:?}",
+            v.as_slice()
+        )))
+    }
+}
+
+/// A world error whose message starts with the Rust argument name `rust`, renamed to the C
+/// argument name `c` (e.g. `positions[3]` → `xyz[3]`).
+fn renamed(error: crate::Error, rust: &str, c: &str) -> Failure {
+    let text = error.to_string();
+    Failure::invalid(match text.strip_prefix(rust) {
+        Some(rest) => format!("{c}{rest}"),
+        None => text,
+    })
+}
+
 /// Writes `value` to `*out`.
 ///
 /// # Safety
@@ -149,17 +230,14 @@ pub unsafe extern "C" fn pf_world_create(
         let params = checked_ptr(params, "params")?;
         // SAFETY: checked pointer; the caller promises it points to a PfParams.
         let params = unsafe { read_params(params) }?;
-        let world = World::new(params)?;
-        let handle = Box::new(PfWorld {
-            world: Mutex::new(world),
-        });
+        let handle = Box::new(PfWorld::new(params)?);
         // SAFETY: as above.
         unsafe { out.write(Box::into_raw(handle)) };
         Ok(())
     })
 }
 
-/// Frees a world and everything it owns (its worker threads finish in the background).
+/// Frees a world and everything it owns, waiting for its worker threads to exit.
 /// NULL is a no-op. The handle must not be used afterwards, nor be in use by another
 /// thread during the call.
 ///
@@ -170,7 +248,7 @@ pub unsafe extern "C" fn pf_world_destroy(world: *mut PfWorld) {
     let _ = status_call("pf_world_destroy", || {
         if !world.is_null() {
             // SAFETY: a handle from pf_world_create, destroyed once (the caller's promise).
-            drop(unsafe { Box::from_raw(world) });
+            unsafe { Box::from_raw(world) }.shutdown();
         }
         Ok(())
     });
@@ -239,8 +317,9 @@ unsafe fn add_fluid(
     world
         .try_reserve_fluid(count)
         .map_err(|_| Failure::out_of_memory("fluid particles"))?;
-    world.add_fluid_particles(&positions, velocities.as_deref())?;
-    Ok(())
+    world
+        .add_fluid_particles(&positions, velocities.as_deref())
+        .map_err(|e| renamed(e, "positions", "xyz"))
 }
 
 /// Adds a box-shaped lattice of fluid particles with spacing 2r: centres at
@@ -264,7 +343,7 @@ pub unsafe extern "C" fn pf_world_add_fluid_box(
         // SAFETY: forwarded from the caller's promises.
         let mut world = unsafe { lock(world) }?;
         // SAFETY: as above.
-        let start = unsafe { read_vec3(start, "start") }?;
+        let start = check_finite(unsafe { read_vec3(start, "start") }?, "start")?;
         // SAFETY: as above.
         let counts = unsafe { input_slice(count, 3, "count") }?;
         let counts = [counts[0], counts[1], counts[2]];
@@ -272,7 +351,7 @@ pub unsafe extern "C" fn pf_world_add_fluid_box(
             Vec3::zeros()
         } else {
             // SAFETY: as above.
-            unsafe { read_vec3(velocity, "velocity") }?
+            check_finite(unsafe { read_vec3(velocity, "velocity") }?, "velocity")?
         };
         let total = counts.iter().try_fold(1usize, |a, &c| a.checked_mul(c));
         if let Some(n) = total.filter(|&n| n > 0 && n <= MAX_PARTICLES_PER_CALL) {
@@ -307,8 +386,9 @@ pub unsafe extern "C" fn pf_world_add_boundary_particles(
         world
             .try_reserve_boundary(count)
             .map_err(|_| Failure::out_of_memory("boundary particles"))?;
-        world.add_boundary_particles(&positions)?;
-        Ok(())
+        world
+            .add_boundary_particles(&positions)
+            .map_err(|e| renamed(e, "positions", "xyz"))
     })
 }
 
@@ -334,6 +414,7 @@ pub unsafe extern "C" fn pf_world_add_container_box(
         let mut world = unsafe { lock(world) }?;
         // SAFETY: as above.
         let (min, max) = unsafe { (read_vec3(min, "min")?, read_vec3(max, "max")?) };
+        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
         world.add_container(Aabb { min, max }, layers as usize)?;
         Ok(())
     })
@@ -640,4 +721,47 @@ pub unsafe extern "C" fn pf_world_positions_hash(
         out[hash.len()] = 0;
         Ok(())
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ffi::{pf_last_error_message, pf_params_default};
+    use std::ffi::CStr;
+
+    fn message() -> String {
+        // SAFETY: the library returns a valid NUL-terminated string.
+        unsafe { CStr::from_ptr(pf_last_error_message()) }
+            .to_string_lossy()
+            .into_owned()
+    }
+
+    #[test]
+    fn a_world_that_panicked_is_poisoned_until_destroyed() {
+        let mut params = std::mem::MaybeUninit::<PfParams>::uninit();
+        let mut world = std::ptr::null_mut();
+        // SAFETY: valid out-pointers; the world is destroyed below.
+        unsafe {
+            assert_eq!(pf_params_default(params.as_mut_ptr()), PfStatus::PF_OK);
+            let mut params = params.assume_init();
+            params.threads = 1;
+            assert_eq!(pf_world_create(&params, &mut world), PfStatus::PF_OK);
+        }
+        // A bug inside a call: the wrapper turns the panic into a status.
+        let status = status_call("pf_test", || {
+            // SAFETY: a live handle.
+            let _world = unsafe { lock(world) }?;
+            panic!("simulated bug")
+        });
+        assert_eq!(status, PfStatus::PF_ERROR_PANIC);
+        assert!(message().contains("simulated bug"), "{}", message());
+        // Every later call on that world refuses to touch it.
+        let mut n = 0usize;
+        // SAFETY: a live handle and a valid out-pointer.
+        let status = unsafe { pf_world_fluid_count(world, &mut n) };
+        assert_eq!(status, PfStatus::PF_ERROR_WORLD_POISONED);
+        assert!(message().contains("destroy it"), "{}", message());
+        // SAFETY: destroyed once, not used afterwards.
+        unsafe { pf_world_destroy(world) };
+    }
 }

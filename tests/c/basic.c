@@ -1,0 +1,121 @@
+/* Builds a small world through the C API, steps it, and reads every output buffer.
+ * Usage: basic [steps]   (default 5; the valgrind run uses fewer) */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "check.h"
+
+int main(int argc, char **argv) {
+    int steps = argc > 1 ? atoi(argv[1]) : 5;
+
+    /* Versions: the header and the library agree. */
+    char version[64];
+    snprintf(version, sizeof version, "%d.%d.%d", PF_VERSION_MAJOR, PF_VERSION_MINOR,
+             PF_VERSION_PATCH);
+    CHECK(strcmp(version, pf_version_string()) == 0);
+    CHECK(pf_abi_version() == PF_ABI_VERSION);
+    CHECK(strcmp(pf_status_name(PF_ERROR_BUFFER_TOO_SMALL), "PF_ERROR_BUFFER_TOO_SMALL") == 0);
+
+    PfParams params;
+    OK(pf_params_default(&params));
+    CHECK(params.particle_radius == 0.025);
+    CHECK(params.solver == PF_SOLVER_CHEBYSHEV);
+    CHECK(params.gravity[1] == -9.81);
+    params.threads = 2;
+    OK(pf_params_validate(&params));
+
+    PfWorld *world = NULL;
+    OK(pf_world_create(&params, &world));
+    CHECK(world != NULL);
+
+    PfParams back;
+    OK(pf_world_get_params(world, &back));
+    CHECK(memcmp(&back.particle_radius, &params.particle_radius, sizeof(double)) == 0);
+    CHECK(back.threads == 2 && back.max_outer_iterations == params.max_outer_iterations);
+
+    const float lo[3] = {-0.00625f, -0.00625f, -0.00625f};
+    const float hi[3] = {0.40625f, 0.40625f, 0.30625f};
+    OK(pf_world_add_container_box(world, lo, hi, 1));
+    const float start[3] = {0.05f, 0.05f, 0.05f};
+    const size_t count[3] = {5, 6, 4};
+    OK(pf_world_add_fluid_box(world, start, count, NULL));
+    const float extra[6] = {0.3f, 0.3f, 0.2f, 0.32f, 0.3f, 0.2f};
+    const float extra_v[6] = {-1.0f, 0.0f, 0.0f, 0.0f, 0.5f, 0.0f};
+    OK(pf_world_add_fluid_particles_with_velocities(world, extra, extra_v, 2));
+
+    size_t n = 0, nb = 0;
+    OK(pf_world_fluid_count(world, &n));
+    OK(pf_world_boundary_count(world, &nb));
+    CHECK(n == 5 * 6 * 4 + 2);
+    CHECK(nb > 0);
+
+    /* Before any step: zero statistics, zero densities, inputs read back exactly. */
+    PfStepStats stats;
+    OK(pf_world_last_step_stats(world, &stats));
+    CHECK(stats.step_count == 0 && stats.dt == 0.0 && stats.escaped_count == 0);
+
+    size_t needed = 0;
+    /* The size query: NULL buffer with capacity 0. */
+    EXPECT(PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_positions(world, NULL, 0, &needed));
+    CHECK(needed == 3 * n);
+    float *pos = malloc(needed * sizeof *pos);
+    float *vel = malloc(needed * sizeof *vel);
+    float *rho = malloc(n * sizeof *rho);
+    CHECK(pos && vel && rho);
+    OK(pf_world_get_positions(world, pos, needed, &needed));
+    CHECK(pos[0] == 0.05f && pos[1] == 0.05f && pos[2] == 0.05f);
+    CHECK(fabsf(pos[3] - 0.1f) < 1e-6f); /* i runs fastest, spacing 2r = 0.05 */
+    CHECK(pos[3 * (n - 2)] == 0.3f && pos[3 * (n - 1)] == 0.32f);
+    OK(pf_world_get_velocities(world, vel, 3 * n, NULL));
+    CHECK(vel[3 * (n - 2)] == -1.0f && vel[3 * (n - 1) + 1] == 0.5f && vel[0] == 0.0f);
+    OK(pf_world_get_densities(world, rho, n, &needed));
+    CHECK(needed == n && rho[0] == 0.0f);
+
+    /* A fixed step, then CFL steps. */
+    OK(pf_world_step(world, 0.002));
+    for (int i = 1; i < steps; i++) OK(pf_world_step(world, 0.0));
+    OK(pf_world_last_step_stats(world, &stats));
+    CHECK(stats.step_count == (uint64_t)(steps > 1 ? steps : 1));
+    CHECK(stats.dt > 0.0 && stats.outer_iterations >= 1 && stats.inner_iterations >= 1);
+    CHECK(stats.density_error_avg_percent >= 0.0);
+    CHECK(stats.density_error_max_percent >= stats.density_error_avg_percent);
+    CHECK(stats.escaped_count == 0 && stats.nan_count == 0);
+    double t = 0.0;
+    OK(pf_world_time(world, &t));
+    CHECK(t == stats.time && t > 0.0);
+
+    OK(pf_world_advance(world, 0.004));
+    double t2 = 0.0;
+    OK(pf_world_time(world, &t2));
+    CHECK(fabs(t2 - (t + 0.004)) < 1e-12);
+
+    OK(pf_world_get_positions(world, pos, 3 * n, NULL));
+    OK(pf_world_get_velocities(world, vel, 3 * n, NULL));
+    OK(pf_world_get_densities(world, rho, n, NULL));
+    double mean_rho = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        for (int a = 0; a < 3; a++) CHECK(isfinite(pos[3 * i + a]) && isfinite(vel[3 * i + a]));
+        CHECK(pos[3 * i + 1] > -0.01f && pos[3 * i + 1] < 0.41f);
+        CHECK(rho[i] > 0.0f);
+        mean_rho += rho[i];
+    }
+    mean_rho /= (double)n;
+    CHECK(mean_rho > 300.0 && mean_rho < 1500.0);
+    /* Gravity pulled the block down. */
+    CHECK(vel[1] < 0.0f);
+
+    char hash[65];
+    OK(pf_world_positions_hash(world, hash, sizeof hash, &needed));
+    CHECK(needed == 65 && strlen(hash) == 64);
+
+    printf("basic: ok, %zu fluid, %zu boundary, t = %.4f s, mean density %.1f kg/m^3\n", n, nb,
+           t2, mean_rho);
+    free(pos);
+    free(vel);
+    free(rho);
+    pf_world_destroy(world);
+    pf_world_destroy(NULL);
+    return 0;
+}

@@ -1,0 +1,261 @@
+/* Every kind of rejected call: each must return the right status, leave a message naming the
+ * function, and leave the world exactly as it was (counts, time, positions bit for bit);
+ * the next valid call must work and clear the message. */
+#include <math.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "check.h"
+
+typedef struct {
+    size_t fluid, boundary;
+    double time;
+    uint64_t steps;
+    char hash[65];
+} Snapshot;
+
+static Snapshot snapshot(const PfWorld *w) {
+    Snapshot s;
+    PfStepStats st;
+    OK(pf_world_fluid_count(w, &s.fluid));
+    OK(pf_world_boundary_count(w, &s.boundary));
+    OK(pf_world_time(w, &s.time));
+    OK(pf_world_last_step_stats(w, &st));
+    s.steps = st.step_count;
+    OK(pf_world_positions_hash(w, s.hash, sizeof s.hash, NULL));
+    return s;
+}
+
+static void same(const PfWorld *w, const Snapshot *before, int line) {
+    Snapshot now = snapshot(w);
+    if (now.fluid != before->fluid || now.boundary != before->boundary ||
+        now.time != before->time || now.steps != before->steps ||
+        strcmp(now.hash, before->hash) != 0) {
+        fprintf(stderr, "misuse.c:%d: a rejected call changed the world\n", line);
+        exit(1);
+    }
+}
+
+/* The message of the last REJECT, kept because the checks after it clear the library's. */
+static char last_msg[512];
+
+/* A rejected call on world `w`: expected status, a message, and no change. */
+#define REJECT(w, expected, call)                                                         \
+    do {                                                                                  \
+        Snapshot before_ = snapshot(w);                                                   \
+        EXPECT(expected, call);                                                           \
+        snprintf(last_msg, sizeof last_msg, "%s", pf_last_error_message());               \
+        same(w, &before_, __LINE__);                                                      \
+        rejected++;                                                                       \
+    } while (0)
+
+static int rejected = 0;
+
+static void bad_params(PfParams p, const char *field) {
+    PfWorld *w = (PfWorld *)&p; /* must be overwritten with NULL */
+    EXPECT(PF_ERROR_INVALID_ARGUMENT, pf_params_validate(&p));
+    if (strstr(pf_last_error_message(), field) == NULL)
+        FAIL("the message does not name %s", field);
+    EXPECT(PF_ERROR_INVALID_ARGUMENT, pf_world_create(&p, &w));
+    if (strstr(pf_last_error_message(), field) == NULL)
+        FAIL("the message does not name %s", field);
+    CHECK(w == NULL);
+    rejected += 2;
+}
+
+int main(void) {
+    PfParams params;
+    OK(pf_params_default(&params));
+    params.threads = 2;
+
+    /* --- Invalid parameters. --- */
+    PfParams p = params;
+    p.particle_radius = 0.0;
+    bad_params(p, "particle_radius");
+    p = params;
+    p.particle_radius = NAN;
+    bad_params(p, "particle_radius");
+    p = params;
+    p.particle_radius = 1e-200; /* the particle mass underflows to zero */
+    bad_params(p, "particle_radius");
+    p = params;
+    p.stiffness = -1.0;
+    bad_params(p, "stiffness");
+    p = params;
+    p.gravity[2] = INFINITY;
+    bad_params(p, "gravity[2]");
+    p = params;
+    p.dt_min = 0.1;
+    bad_params(p, "dt_min");
+    p = params;
+    p.chebyshev_rho = 1.0;
+    bad_params(p, "rho");
+    p = params;
+    p.chebyshev_delay = 0;
+    bad_params(p, "delay");
+    p = params;
+    p.chebyshev_gamma = 0.0;
+    bad_params(p, "gamma");
+    p = params;
+    p.max_outer_iterations = 0;
+    bad_params(p, "max_outer_iterations");
+    p = params;
+    p.viscosity = 2.0;
+    bad_params(p, "viscosity");
+    p = params;
+    p.threads = 5000;
+    bad_params(p, "threads");
+    p = params;
+    p.solver = (PfSolver)7;
+    bad_params(p, "solver");
+    p = params;
+    p.omega2_rule = (PfOmega2Rule)9;
+    bad_params(p, "omega2_rule");
+    p = params;
+    p.projection_weight = (PfProjectionWeight)-1;
+    bad_params(p, "projection_weight");
+
+    /* --- NULL pointers outside a world. --- */
+    PfWorld *w = NULL;
+    EXPECT(PF_ERROR_NULL_POINTER, pf_params_default(NULL));
+    EXPECT(PF_ERROR_NULL_POINTER, pf_params_validate(NULL));
+    EXPECT(PF_ERROR_NULL_POINTER, pf_world_create(&params, NULL));
+    w = (PfWorld *)&params;
+    EXPECT(PF_ERROR_NULL_POINTER, pf_world_create(NULL, &w));
+    CHECK(w == NULL);
+    rejected += 4;
+
+    /* --- An empty world cannot step; advancing by 0 is fine. --- */
+    OK(pf_world_create(&params, &w));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, 0.0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, 0.01));
+    OK(pf_world_advance(w, 0.0));
+
+    /* --- A valid world to misuse. --- */
+    const float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.3f, 0.3f, 0.3f};
+    OK(pf_world_add_container_box(w, lo, hi, 1));
+    const float start[3] = {0.05f, 0.05f, 0.05f};
+    const size_t count[3] = {3, 3, 3};
+    OK(pf_world_add_fluid_box(w, start, count, NULL));
+    OK(pf_world_step(w, 0.0));
+    size_t n = 0;
+    OK(pf_world_fluid_count(w, &n));
+    CHECK(n == 27);
+
+    /* NULL world, for every function that takes one. */
+    const float xyz[6] = {0.1f, 0.1f, 0.1f, 0.2f, 0.1f, 0.1f};
+    float buf[3 * 27 + 8];
+    size_t needed = 0, sz = 0;
+    double t = 0.0;
+    PfStepStats st;
+    PfParams back;
+    char hash[65];
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_particles(NULL, xyz, 2));
+    REJECT(w, PF_ERROR_NULL_POINTER,
+           pf_world_add_fluid_particles_with_velocities(NULL, xyz, xyz, 2));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_box(NULL, start, count, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_boundary_particles(NULL, xyz, 2));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(NULL, lo, hi, 1));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_step(NULL, 0.0));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_advance(NULL, 0.01));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_count(NULL, &sz));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_boundary_count(NULL, &sz));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_time(NULL, &t));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_params(NULL, &back));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_last_step_stats(NULL, &st));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_positions(NULL, buf, 81, &needed));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_velocities(NULL, buf, 81, &needed));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_densities(NULL, buf, 27, &needed));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_positions_hash(NULL, hash, 65, &needed));
+
+    /* NULL buffers and outputs. */
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_particles(w, NULL, 2));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_boundary_particles(w, NULL, 2));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_box(w, NULL, count, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_box(w, start, NULL, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(w, NULL, hi, 1));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(w, lo, NULL, 1));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_count(w, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_boundary_count(w, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_time(w, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_params(w, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_last_step_stats(w, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_positions(w, NULL, 81, &needed));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_velocities(w, NULL, 81, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_densities(w, NULL, 27, NULL));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_positions_hash(w, NULL, 65, NULL));
+
+    /* Short buffers: the size needed is reported and the buffer is left untouched. */
+    for (size_t i = 0; i < sizeof buf / sizeof *buf; i++) buf[i] = -7.0f;
+    needed = 0;
+    REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_positions(w, buf, 80, &needed));
+    CHECK(needed == 81);
+    REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_velocities(w, buf, 3, &needed));
+    CHECK(needed == 81);
+    REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_densities(w, buf, 26, &needed));
+    CHECK(needed == 27);
+    REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_positions_hash(w, hash, 64, &needed));
+    CHECK(needed == 65);
+    for (size_t i = 0; i < sizeof buf / sizeof *buf; i++) CHECK(buf[i] == -7.0f);
+    /* A larger buffer than needed is fine; the tail stays untouched. */
+    OK(pf_world_get_positions(w, buf, sizeof buf / sizeof *buf, &needed));
+    CHECK(needed == 81 && buf[81] == -7.0f && buf[0] != -7.0f);
+
+    /* Non-finite coordinates, with the index named. */
+    float nan_xyz[6] = {0.1f, 0.1f, 0.1f, 0.2f, NAN, 0.1f};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_particles(w, nan_xyz, 2));
+    CHECK(strstr(last_msg, "xyz[1]") != NULL);
+    float inf_v[6] = {0.0f, 0.0f, 0.0f, INFINITY, 0.0f, 0.0f};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+           pf_world_add_fluid_particles_with_velocities(w, xyz, inf_v, 2));
+    CHECK(strstr(last_msg, "velocities[1]") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_boundary_particles(w, nan_xyz, 2));
+    const float nan3[3] = {0.0f, NAN, 0.0f}, inf3[3] = {-INFINITY, 0.0f, 0.0f};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_box(w, nan3, count, NULL));
+    CHECK(strstr(last_msg, "start must be finite") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_box(w, start, count, inf3));
+    CHECK(strstr(last_msg, "velocity must be finite") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, inf3, hi, 1));
+    CHECK(strstr(last_msg, "min must be finite") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, nan3, 1));
+    CHECK(strstr(last_msg, "max must be finite") != NULL);
+
+    /* Zero and absurd counts. */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_particles(w, xyz, 0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_boundary_particles(w, xyz, 0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_particles(w, xyz, SIZE_MAX));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_particles(w, xyz, SIZE_MAX / 3 + 1));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_boundary_particles(w, xyz, SIZE_MAX / 2));
+    const size_t zero[3] = {4, 0, 4}, overflow[3] = {SIZE_MAX, SIZE_MAX, 2},
+                 huge[3] = {100000, 100000, 100000};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_box(w, start, zero, NULL));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_box(w, start, overflow, NULL));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_fluid_box(w, start, huge, NULL));
+    const float far[3] = {1000.0f, 1000.0f, 1000.0f};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, far, 1));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, hi, lo, 1)); /* inverted */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 4));
+
+    /* Bad step sizes and durations. */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, NAN));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, INFINITY));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, -INFINITY));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, 2.0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, -0.1));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, NAN));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, INFINITY));
+
+    /* Calls after all those failures work normally and clear the message. */
+    OK(pf_world_add_fluid_particles(w, xyz, 2));
+    OK(pf_world_fluid_count(w, &n));
+    CHECK(n == 29);
+    OK(pf_world_step(w, 0.0));
+    OK(pf_world_last_step_stats(w, &st));
+    CHECK(st.step_count == 2 && st.nan_count == 0);
+
+    pf_world_destroy(w);
+    printf("misuse: ok, %d rejected calls checked\n", rejected);
+    return 0;
+}

@@ -1,0 +1,365 @@
+//! Exercises the C API from C: compiles `tests/c/*.c` and `c_examples/*.c` with the system
+//! `cc` (C11, all warnings as errors) against the crate's static and shared libraries, runs
+//! them, checks their exit codes and output, compares a C simulation bit for bit with the
+//! Rust API, runs the C tests under valgrind when it is installed, runs the Python ctypes
+//! example when `python3` is installed, and checks the `make install-files` layout with
+//! pkg-config.
+//!
+//! Under `cargo test` the libraries sit next to this test's executable in
+//! `target/<profile>/deps/`.
+
+use projfluid::boundary::Aabb;
+use projfluid::{ChebyshevParams, Params, SolverKind, Vec3, World};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+/// How an executable links the library.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+enum Link {
+    /// `libprojfluid.a` plus the system libraries Rust's standard library needs.
+    Static,
+    /// `libprojfluid.so` found through an rpath.
+    Shared,
+}
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The directory holding `libprojfluid.a` and `libprojfluid.so` for this build.
+fn lib_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("the test knows its own path");
+    let dir = exe
+        .parent()
+        .expect("the test executable has a directory")
+        .to_path_buf();
+    for lib in ["libprojfluid.a", "libprojfluid.so"] {
+        assert!(
+            dir.join(lib).exists(),
+            "{} is missing; the crate's staticlib/cdylib should be built by cargo test",
+            dir.join(lib).display()
+        );
+    }
+    dir
+}
+
+/// Where compiled C programs and their output files go.
+fn out_dir() -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("c_api");
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn describe(output: &Output) -> String {
+    format!(
+        "exit status {}\n--- stdout ---\n{}\n--- stderr ---\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
+/// Compiles `source` (relative to the crate root) once per link kind, returning the program.
+fn build(source: &str, link: Link) -> PathBuf {
+    static BUILT: Mutex<Option<HashMap<(String, Link), PathBuf>>> = Mutex::new(None);
+    let mut built = BUILT.lock().unwrap_or_else(|e| e.into_inner());
+    let built = built.get_or_insert_with(HashMap::new);
+    if let Some(exe) = built.get(&(source.to_string(), link)) {
+        return exe.clone();
+    }
+    let stem = Path::new(source).file_stem().unwrap().to_string_lossy();
+    let exe = out_dir().join(format!("{stem}-{link:?}").to_lowercase());
+    let libs = lib_dir();
+    let mut cc = Command::new("cc");
+    cc.args([
+        "-std=c11",
+        "-Wall",
+        "-Wextra",
+        "-Wpedantic",
+        "-Werror",
+        "-O1",
+        "-g",
+    ])
+    .arg("-I")
+    .arg(root().join("include"))
+    .arg("-I")
+    .arg(root().join("tests/c"))
+    .arg(root().join(source))
+    .arg("-o")
+    .arg(&exe);
+    match link {
+        Link::Static => {
+            cc.arg(libs.join("libprojfluid.a"))
+                .args(["-lm", "-lpthread", "-ldl"]);
+        }
+        Link::Shared => {
+            cc.arg("-L")
+                .arg(&libs)
+                .arg("-lprojfluid")
+                .arg(format!("-Wl,-rpath,{}", libs.display()))
+                .args(["-lm", "-lpthread"]);
+        }
+    }
+    let output = cc.output().expect("the C compiler `cc` must be installed");
+    assert!(
+        output.status.success(),
+        "compiling {source} ({link:?}) failed: {}",
+        describe(&output)
+    );
+    built.insert((source.to_string(), link), exe.clone());
+    exe
+}
+
+/// Runs `program` with `args`, requires exit code 0, and returns its stdout.
+fn run(program: &Path, args: &[&str]) -> String {
+    let output = Command::new(program)
+        .args(args)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run {}: {e}", program.display()));
+    assert!(
+        output.status.success(),
+        "{} {args:?} failed: {}",
+        program.display(),
+        describe(&output)
+    );
+    String::from_utf8(output.stdout).unwrap()
+}
+
+#[test]
+fn basic_c_program_runs_with_static_and_shared_library() {
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/basic.c", link), &["5"]);
+        assert!(out.starts_with("basic: ok"), "{link:?}: {out}");
+    }
+}
+
+#[test]
+fn misuse_is_rejected_with_status_and_message_leaving_the_world_unchanged() {
+    let out = run(&build("tests/c/misuse.c", Link::Static), &[]);
+    assert!(out.starts_with("misuse: ok"), "{out}");
+    let checked: usize = out
+        .split_whitespace()
+        .find_map(|w| w.parse().ok())
+        .expect("misuse prints the number of rejected calls");
+    assert!(checked >= 90, "only {checked} rejected calls were checked");
+}
+
+#[test]
+fn distinct_worlds_step_in_parallel_and_one_world_reports_busy() {
+    let out = run(&build("tests/c/parallel.c", Link::Shared), &["6"]);
+    assert!(out.starts_with("parallel: ok"), "{out}");
+}
+
+/// The world `tests/c/bitwise.c` builds and steps, through the Rust API with the same
+/// float inputs widened to f64 exactly as the C API does.
+fn rust_reference() -> World {
+    let v = |x: f32, y: f32, z: f32| Vec3::new(x.into(), y.into(), z.into());
+    let defaults = Params::default();
+    let params = Params {
+        particle_radius: 0.02,
+        displacement_tolerance: 2e-5,
+        solver: SolverKind::Chebyshev,
+        chebyshev: ChebyshevParams {
+            rho: 0.85,
+            ..defaults.chebyshev
+        },
+        threads: 2,
+        ..defaults
+    };
+    let mut world = World::new(params).unwrap();
+    let container = Aabb {
+        min: v(-0.005, -0.005, -0.005),
+        max: v(0.5, 0.4, 0.3),
+    };
+    world.add_container(container, 2).unwrap();
+    world
+        .add_fluid_block(v(0.03, 0.03, 0.03), [6, 7, 5], v(0.25, 0.0, -0.125))
+        .unwrap();
+    let drops = [v(0.4, 0.3, 0.15), v(0.41, 0.25, 0.1), v(0.2, 0.35, 0.2)];
+    let drop_v = [v(-0.5, 0.0, 0.0), v(0.0, -1.0, 0.1), v(0.0, 0.0, 0.0)];
+    world.add_fluid_particles(&drops, Some(&drop_v)).unwrap();
+    world
+        .add_boundary_particles(&[v(0.25, 0.01, 0.15), v(0.25, 0.03, 0.15)])
+        .unwrap();
+    world.step_with_dt(0.002).unwrap();
+    world.step().unwrap();
+    world.step().unwrap();
+    world.advance(0.01).unwrap();
+    world
+}
+
+#[test]
+fn c_simulation_matches_the_rust_api_bit_for_bit() {
+    let file = out_dir().join("bitwise_positions.f32");
+    let _ = std::fs::remove_file(&file);
+    let out = run(
+        &build("tests/c/bitwise.c", Link::Shared),
+        &[file.to_str().unwrap()],
+    );
+    let c_hash = out
+        .lines()
+        .find_map(|l| l.strip_prefix("hash "))
+        .expect("bitwise prints the positions hash");
+
+    let world = rust_reference();
+    assert_eq!(world.fluid_count(), 6 * 7 * 5 + 3);
+    assert_eq!(
+        c_hash,
+        world.positions_hash(),
+        "double-precision positions differ"
+    );
+    let expected: Vec<u8> = world
+        .positions()
+        .iter()
+        .flat_map(|p| p.iter().map(|&c| c as f32).collect::<Vec<_>>())
+        .flat_map(f32::to_ne_bytes)
+        .collect();
+    let written = std::fs::read(&file).unwrap();
+    assert_eq!(written.len(), expected.len(), "float count differs");
+    assert!(
+        written == expected,
+        "the float positions read through the C API differ from World::positions()"
+    );
+}
+
+#[test]
+fn c_examples_build_and_run() {
+    let out = run(&build("c_examples/minimal.c", Link::Static), &[]);
+    assert!(out.contains("first particle at"), "{out}");
+
+    // The example simulates 0.5 s by default; a shorter run keeps the test fast.
+    let out = run(&build("c_examples/dam_break.c", Link::Shared), &["0.1"]);
+    assert!(
+        out.starts_with("dam_break: 3840 fluid and"),
+        "unexpected start: {out}"
+    );
+    let last = out.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("final: ") && last.contains("escaped 0"),
+        "{out}"
+    );
+    let avg: f64 = last
+        .split("over the run ")
+        .nth(1)
+        .and_then(|s| s.split_whitespace().next())
+        .and_then(|s| s.parse().ok())
+        .expect("the final line reports the mean density error");
+    assert!((0.0..5.0).contains(&avg), "mean density error {avg} %");
+}
+
+fn have(tool: &str) -> bool {
+    Command::new(tool)
+        .arg("--version")
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+#[test]
+fn c_tests_are_clean_under_valgrind() {
+    if !have("valgrind") {
+        eprintln!("note: valgrind is not on PATH; skipping the memcheck run of the C tests");
+        return;
+    }
+    let suppressions = root().join("tests/c/valgrind.supp");
+    for (source, args) in [
+        ("tests/c/basic.c", &["2"][..]),
+        ("tests/c/misuse.c", &[][..]),
+        ("tests/c/parallel.c", &["2"][..]),
+    ] {
+        let program = build(source, Link::Static);
+        let output = Command::new("valgrind")
+            .args(["--error-exitcode=99", "--leak-check=full", "--quiet"])
+            .arg(format!("--suppressions={}", suppressions.display()))
+            .arg(&program)
+            .args(args)
+            .output()
+            .expect("valgrind runs");
+        assert!(
+            output.status.success(),
+            "valgrind found errors or leaks in {source}: {}",
+            describe(&output)
+        );
+    }
+}
+
+#[test]
+fn python_ctypes_example_runs() {
+    if !have("python3") {
+        eprintln!("note: python3 is not on PATH; skipping the ctypes example");
+        return;
+    }
+    let lib = lib_dir().join("libprojfluid.so");
+    let output = Command::new("python3")
+        .arg(root().join("c_examples/python/dam_break.py"))
+        .arg(&lib)
+        .output()
+        .expect("python3 runs");
+    assert!(output.status.success(), "{}", describe(&output));
+    let out = String::from_utf8(output.stdout).unwrap();
+    let last = out.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("python dam_break: ok") && last.contains("escaped 0"),
+        "{out}"
+    );
+}
+
+#[test]
+fn make_install_layout_works_with_pkg_config() {
+    if !have("make") {
+        eprintln!("note: make is not on PATH; skipping the install layout check");
+        return;
+    }
+    let prefix = out_dir().join("prefix");
+    let _ = std::fs::remove_dir_all(&prefix);
+    // `install-files` is `make install` without its `cargo build --release` step, fed with
+    // the libraries of this build.
+    let output = Command::new("make")
+        .current_dir(root())
+        .arg("install-files")
+        .arg(format!("PREFIX={}", prefix.display()))
+        .arg(format!("BUILT={}", lib_dir().display()))
+        .output()
+        .expect("make runs");
+    assert!(output.status.success(), "{}", describe(&output));
+    for file in [
+        "lib/libprojfluid.a",
+        "lib/libprojfluid.so",
+        "include/projfluid.h",
+        "lib/pkgconfig/projfluid.pc",
+    ] {
+        assert!(prefix.join(file).exists(), "{file} was not installed");
+    }
+    let pc = std::fs::read_to_string(prefix.join("lib/pkgconfig/projfluid.pc")).unwrap();
+    assert!(
+        pc.contains(&format!("Version: {}", env!("CARGO_PKG_VERSION"))),
+        "{pc}"
+    );
+    assert!(pc.contains(&format!("prefix={}", prefix.display())), "{pc}");
+
+    if !have("pkg-config") {
+        eprintln!("note: pkg-config is not on PATH; skipping the pkg-config build");
+        return;
+    }
+    let flags = Command::new("pkg-config")
+        .args(["--cflags", "--libs", "projfluid"])
+        .env("PKG_CONFIG_PATH", prefix.join("lib/pkgconfig"))
+        .output()
+        .expect("pkg-config runs");
+    assert!(flags.status.success(), "{}", describe(&flags));
+    let flags = String::from_utf8(flags.stdout).unwrap();
+    let exe = out_dir().join("minimal-pkgconfig");
+    let output = Command::new("cc")
+        .args(["-std=c11", "-Wall", "-Wextra", "-Wpedantic", "-Werror"])
+        .arg(root().join("c_examples/minimal.c"))
+        .arg("-o")
+        .arg(&exe)
+        .args(flags.split_whitespace())
+        .arg(format!("-Wl,-rpath,{}", prefix.join("lib").display()))
+        .output()
+        .expect("cc runs");
+    assert!(output.status.success(), "{}", describe(&output));
+    let out = run(&exe, &[]);
+    assert!(out.contains("first particle at"), "{out}");
+}

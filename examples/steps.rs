@@ -5,9 +5,11 @@ fn main() {
         .nth(1)
         .map(|s| s.parse().unwrap())
         .unwrap_or(20);
-    let mut p = Params::default();
-    p.solver = SolverKind::Jacobi1;
-    p.threads = 1;
+    let p = Params {
+        solver: SolverKind::Jacobi1,
+        threads: 1,
+        ..Params::default()
+    };
     let mut w = World::new(p).unwrap();
     w.add_container(
         Aabb {

@@ -154,8 +154,9 @@ impl UniformGrid {
             .for_each(|(b, (counts, found))| {
                 counts.clear();
                 found.clear();
-                for i in b * BLOCK..((b + 1) * BLOCK).min(queries.len()) {
-                    let q = queries[i];
+                let first = b * BLOCK;
+                let end = (first + BLOCK).min(queries.len());
+                for (i, &q) in queries.iter().enumerate().take(end).skip(first) {
                     let start = found.len();
                     let c = self.cell_of(&q);
                     for z in c[2].saturating_sub(1)..=(c[2] + 1).min(self.dims[2] - 1) {

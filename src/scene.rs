@@ -1,5 +1,5 @@
 //! Scenes: a fluid setup (parameters, container boxes, blocks of fluid, duration, output)
-//! read from JSON (format in `docs/scene-format.md`) or taken from the built-in list.
+//! read from JSON (format in the README ("Scene files")) or taken from the built-in list.
 //!
 //! ```
 //! use projfluid::scene::Scene;
@@ -540,12 +540,12 @@ mod tests {
 
     #[test]
     fn documented_example_is_valid() {
-        let doc = include_str!("../docs/scene-format.md");
+        let doc = include_str!("../README.md");
         let example = doc
             .split("```json\n")
             .nth(1)
             .and_then(|rest| rest.split("```").next())
-            .expect("docs/scene-format.md has a json example");
+            .expect("README.md has a json scene example");
         let scene = Scene::from_json(example).unwrap();
         let mut expected = Scene::builtin("dam_break_small").unwrap();
         expected.description = scene.description.clone();

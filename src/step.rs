@@ -36,6 +36,8 @@ pub(crate) struct StepBuffers {
     system: DiagonalSystem,
     scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
+    /// δ_k of every outer iteration of the last step (m).
+    pub(crate) displacements: Vec<f64>,
 }
 
 impl World {
@@ -178,6 +180,7 @@ impl World {
             chebyshev.reset();
             let accelerate = params.solver == SolverKind::Chebyshev;
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
+            b.displacements.clear();
             while outer < params.max_outer_iterations {
                 let t = Instant::now();
                 constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
@@ -204,6 +207,7 @@ impl World {
                     chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
                 }
                 displacement = max_distance(&b.next, &b.current);
+                b.displacements.push(displacement);
                 // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
                 std::mem::swap(&mut b.previous, &mut b.current);
                 std::mem::swap(&mut b.current, &mut b.next);

@@ -272,6 +272,11 @@ impl World {
         self.last.as_ref()
     }
 
+    /// δ_k, the largest particle displacement (m) of each outer iteration of the last step.
+    pub fn last_displacements(&self) -> &[f64] {
+        &self.buffers.displacements
+    }
+
     /// The container boxes added so far.
     pub fn containers(&self) -> &[Aabb] {
         &self.containers
@@ -520,5 +525,49 @@ impl World {
             out[i..i + 3].copy_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
         }
         Ok(())
+    }
+}
+
+use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
+
+/// Most boundary particles one triangle mesh may need (by [`sample_count_bound`]), which also
+/// bounds the sampler's time and memory.
+const MAX_MESH_SAMPLES: f64 = 50e6;
+
+/// Static triangle meshes as obstacles.
+impl World {
+    /// Adds a static obstacle: the surface of `mesh` (m) sampled by Poisson disk with a
+    /// minimum distance of one particle radius r (see [`sample_poisson_disk`]), the samples
+    /// added as boundary particles. Their Akinci volumes are computed before the next step.
+    /// Winding does not matter and the mesh need not be closed; only the surface is sampled,
+    /// one layer thick. Errors, leaving the world unchanged, when the mesh is far larger than r
+    /// (an extent above 10⁶·r or more than about 5·10⁷ samples) or the boundary particle
+    /// limit would be exceeded.
+    pub fn add_boundary_mesh(&mut self, mesh: &TriangleMesh) -> Result<(), Error> {
+        let r = self.params.particle_radius;
+        let bounds = mesh.bounds();
+        let size = bounds.max - bounds.min;
+        if size.iter().any(|&s| s / r > 1e6) {
+            return Err(Error::invalid(
+                "mesh",
+                format!("extent {:?} m", size.as_slice()),
+                &format!("is too large for the particle radius {r} m (at most 1e6·r per axis)"),
+            ));
+        }
+        let bound = sample_count_bound(mesh, r);
+        if !(bound <= MAX_MESH_SAMPLES
+            && bound + self.boundary.positions.len() as f64 <= MAX_PARTICLES as f64)
+        {
+            return Err(Error::invalid(
+                "mesh",
+                format!("area {:.3e} m² needing up to {bound:.3e}", mesh.area()),
+                &format!(
+                    "is too large for the particle radius {r} m (at most {MAX_MESH_SAMPLES:.0e} \
+                     boundary particles, {MAX_PARTICLES} in all)"
+                ),
+            ));
+        }
+        let samples = sample_poisson_disk(mesh, r);
+        self.add_boundary_particles(&samples)
     }
 }

@@ -1,0 +1,58 @@
+//! Runs one scene with one solver configuration and prints a JSON line of what the defaults
+//! are chosen by: outer iterations, density errors, energy rise, time per step.
+//!
+//! `cargo run --release --example calibrate -- SCENE SECONDS SOLVER RHO DELAY OMEGA2 TAU_PER_R`
+//! e.g. `… dam_break_30k 1.0 chebyshev 0.9 3 chebyshev 1e-3`.
+use projfluid::scene::Scene;
+use projfluid::stats::RunAccumulator;
+use projfluid::{Omega2Rule, SolverKind};
+use std::time::Instant;
+
+fn main() {
+    let a: Vec<String> = std::env::args().skip(1).collect();
+    if a.len() != 7 {
+        eprintln!("usage: calibrate SCENE SECONDS SOLVER RHO DELAY OMEGA2 TAU_PER_R");
+        std::process::exit(2);
+    }
+    let mut scene = Scene::resolve(&a[0]).expect("scene");
+    let seconds: f64 = a[1].parse().expect("seconds");
+    let p = &mut scene.params;
+    p.solver = SolverKind::from_name(&a[2]).expect("solver");
+    p.chebyshev.rho = a[3].parse().expect("rho");
+    p.chebyshev.delay = a[4].parse().expect("delay");
+    p.chebyshev.omega2_rule = Omega2Rule::from_name(&a[5]).expect("omega2");
+    p.displacement_tolerance = a[6].parse::<f64>().expect("tau") * p.particle_radius;
+    let mut world = scene.build_world().expect("world");
+    let energy = |w: &projfluid::World| w.kinetic_energy() + w.potential_energy();
+    let e0 = energy(&world);
+    let (mut e_max, mut hits) = (e0, 0);
+    let mut acc = RunAccumulator::default();
+    while world.time() < seconds - 1e-12 {
+        let t = Instant::now();
+        let stats = world.step().expect("step").clone();
+        acc.add(&stats, t.elapsed().as_secs_f64());
+        hits += stats.hit_max_iterations as usize;
+        e_max = e_max.max(energy(&world));
+    }
+    let s = acc.summary(&a[0], &world);
+    println!(
+        "{{\"scene\":\"{}\",\"solver\":\"{}\",\"rho\":{},\"delay\":{},\"omega2\":\"{}\",\"tau_per_r\":{},\"steps\":{},\"outer_mean\":{:.3},\"ms_per_step\":{:.2},\"err_avg_pct\":{:.5},\"err_max_pct\":{:.3},\"energy_rise_j\":{:.4},\"energy_end_j\":{:.3},\"e0\":{:.3},\"kmax_hits\":{},\"escaped\":{},\"nan\":{}}}",
+        a[0],
+        a[2],
+        a[3],
+        a[4],
+        a[5],
+        a[6],
+        s.steps,
+        s.outer_iterations_mean,
+        s.wall_ms_per_step,
+        s.density_error_avg_percent,
+        s.density_error_max_percent,
+        e_max - e0,
+        energy(&world),
+        e0,
+        hits,
+        s.escaped,
+        s.nan
+    );
+}

@@ -1,0 +1,187 @@
+//! Physical behaviour of the solver: a tank at rest, the small dam break, determinism across
+//! thread counts, and what Chebyshev acceleration must and must not change.
+
+use projfluid::boundary::Aabb;
+use projfluid::scene::Scene;
+use projfluid::{Params, SolverKind, Vec3, World};
+
+/// Runs `world` until `seconds` of simulated time, calling `each` after every step.
+fn run(world: &mut World, seconds: f64, mut each: impl FnMut(&World)) {
+    while world.time() < seconds - 1e-12 {
+        world.step().expect("step");
+        each(world);
+    }
+}
+
+fn small_dam_break(solver: SolverKind, rho: Option<f64>, threads: usize) -> World {
+    let mut scene = Scene::builtin("dam_break_small").expect("built-in scene");
+    scene.params.solver = solver;
+    scene.params.threads = threads;
+    if let Some(rho) = rho {
+        scene.params.chebyshev.rho = rho;
+    }
+    scene.build_world().expect("world")
+}
+
+/// A closed tank holding a column of water initialised at rest density (mass factor 1),
+/// 12 × 16 × 12 particles, walls one spacing from the outer layers (plus r/4 so that no
+/// corner starts compressed). Returns the world after `seconds` and the worst step's average
+/// density error.
+fn resting_column(seconds: f64) -> (World, Aabb, f64) {
+    let params = Params {
+        mass_factor: 1.0,
+        ..Params::default()
+    };
+    let (r, d) = (params.particle_radius, params.spacing());
+    let mut world = World::new(params).unwrap();
+    let n = [12usize, 16, 12];
+    let gap = d + 0.25 * r;
+    let floor = d - gap;
+    let inner = |count: usize| (count - 1) as f64 * d + 2.0 * gap;
+    let container = Aabb {
+        min: Vec3::repeat(floor),
+        max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
+    };
+    world.add_container(container, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
+        .unwrap();
+    let mut worst: f64 = 0.0;
+    run(&mut world, seconds, |w| {
+        worst = worst.max(w.last_step().unwrap().density_error_avg)
+    });
+    (world, container, worst)
+}
+
+/// The resting column after 2 s: nothing escapes, it is not compressed, and its height is the
+/// one its volume N·V implies.
+#[test]
+fn resting_water_column_keeps_its_volume() {
+    let (world, container, worst) = resting_column(2.0);
+    assert_eq!(world.escaped_count(), 0);
+    assert_eq!(world.nan_count(), 0);
+    let avg = world.last_step().unwrap().density_error_avg;
+    assert!(avg <= 1e-3, "average density error {:.4} %", avg * 100.0);
+    assert!(worst <= 1e-3, "worst step {:.4} %", worst * 100.0);
+
+    // Volume N·V with V = m/ρ0. Wall particles keep fluid centres one spacing d from the wall
+    // plane and each particle owns a cube of edge d, so the fluid body ends d/2 from every
+    // wall: it fills (L_x − d)(L_z − d) and starts d/2 above the floor.
+    let d = world.params().spacing();
+    let volume = world.fluid_count() as f64 * world.particle_mass() / world.params().rest_density;
+    let size = container.max - container.min;
+    let expected = volume / ((size.x - d) * (size.z - d));
+    let positions = world.positions();
+    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let surface: Vec<f64> = positions
+        .iter()
+        .map(|p| p.y)
+        .filter(|&y| y > top - 0.5 * d)
+        .collect();
+    let surface_y = surface.iter().sum::<f64>() / surface.len() as f64 + 0.5 * d;
+    let height = surface_y - (container.min.y + 0.5 * d);
+    assert!(
+        (height - expected).abs() <= d,
+        "water height {height:.4} m, expected {expected:.4} m from N·V/area"
+    );
+}
+
+/// The resting column comes to rest: RMS velocity below 1 cm/s after 2 s.
+///
+/// Known failure: with the reference projection weighting (w_j = n_j + 1) the outer iteration
+/// converges at ≈ 0.98 per iteration in a 16-layer column at Δt = 5 ms, and the displacement
+/// rule leaves a residual that becomes ≈ 6 cm/s of velocity noise (8 cm/s with Chebyshev).
+#[test]
+#[ignore = "open: the resting column keeps ≈ 6–8 cm/s RMS velocity noise (issue 2 note)"]
+fn resting_water_column_comes_to_rest() {
+    let (world, _, _) = resting_column(2.0);
+    let rms = world.rms_velocity();
+    assert!(rms < 0.01, "rms velocity {rms} m/s after 2 s");
+}
+
+/// The small dam break for 1 s: finite, contained, incompressible to 0.1 %, and its total
+/// energy (kinetic + potential) never exceeds the initial value.
+#[test]
+fn small_dam_break_is_stable_contained_and_dissipative() {
+    let mut world = small_dam_break(SolverKind::Chebyshev, None, 0);
+    let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
+    let initial = energy(&world);
+    let (mut highest, mut error_sum, mut steps) = (initial, 0.0, 0);
+    run(&mut world, 1.0, |w| {
+        highest = highest.max(energy(w));
+        error_sum += w.last_step().unwrap().density_error_avg;
+        steps += 1;
+        assert_eq!(w.nan_count(), 0, "NaN at t = {}", w.time());
+        assert_eq!(w.escaped_count(), 0, "escaped at t = {}", w.time());
+    });
+    let average = error_sum / steps as f64;
+    assert!(
+        average <= 1e-3,
+        "average density error {:.4} %",
+        average * 100.0
+    );
+    assert!(
+        highest <= initial,
+        "energy rose from {initial} J to {highest} J"
+    );
+    // The column must actually have collapsed and dissipated (initial energy ≈ 1978 J).
+    assert!(
+        energy(&world) < 0.9 * initial,
+        "energy {} J of {initial} J",
+        energy(&world)
+    );
+    let front = world
+        .positions()
+        .iter()
+        .map(|p| p.x)
+        .fold(f64::MIN, f64::max);
+    assert!(front > 1.8, "the surge front only reached x = {front} m");
+}
+
+/// Same scene and settings, one thread or two: bitwise identical positions.
+#[test]
+fn positions_do_not_depend_on_thread_count() {
+    let hash = |threads| {
+        let mut world = small_dam_break(SolverKind::Chebyshev, None, threads);
+        run(&mut world, 0.4, |_| {});
+        assert!(world.steps() > 50);
+        world.positions_hash()
+    };
+    assert_eq!(hash(1), hash(2));
+}
+
+/// ρ = 0 makes every Chebyshev weight 1: exactly the plain iteration, bit for bit.
+#[test]
+fn chebyshev_with_zero_rho_is_the_plain_iteration() {
+    let mut plain = small_dam_break(SolverKind::Jacobi1, None, 0);
+    let mut chebyshev = small_dam_break(SolverKind::Chebyshev, Some(0.0), 0);
+    let mut iterations = 0;
+    for _ in 0..120 {
+        let a = plain.step().unwrap().outer_iterations;
+        let b = chebyshev.step().unwrap().outer_iterations;
+        assert_eq!(a, b);
+        iterations += a;
+    }
+    assert!(iterations > 300, "the steps must iterate ({iterations})");
+    assert_eq!(plain.positions_hash(), chebyshev.positions_hash());
+}
+
+/// At its default ρ, Chebyshev needs fewer outer iterations than the plain iteration.
+#[test]
+fn chebyshev_needs_fewer_outer_iterations_than_plain() {
+    let mean_iterations = |solver| {
+        let mut world = small_dam_break(solver, None, 0);
+        let (mut total, mut steps) = (0, 0);
+        run(&mut world, 1.0, |w| {
+            total += w.last_step().unwrap().outer_iterations;
+            steps += 1;
+        });
+        total as f64 / steps as f64
+    };
+    let plain = mean_iterations(SolverKind::Jacobi1);
+    let accelerated = mean_iterations(SolverKind::Chebyshev);
+    assert!(
+        accelerated < 0.85 * plain,
+        "chebyshev {accelerated:.2} vs plain {plain:.2} outer iterations per step"
+    );
+}

@@ -402,6 +402,30 @@ enum PfStatus pf_world_add_boundary_particles(struct PfWorld *world,
                                               size_t count);
 
 /**
+ * Adds a static obstacle given as a triangle mesh: `vertex_count` vertices `vertices`
+ * (3·vertex_count floats: x, y, z per vertex, metres) and `triangle_count` triangles
+ * `indices` (3·triangle_count zero-based vertex indices). The surface is sampled by
+ * Poisson disk with boundary particles about one particle radius r apart (no two closer
+ * than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
+ * always gives the same particles). Winding does not matter, and the mesh need not be
+ * closed or connected; only its surface is sampled. The mesh itself is not kept.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
+ * limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,
+ * named as `triangles[t][k]`, i.e. `indices[3·t + k]`; a degenerate triangle `triangles[t]`
+ * with a repeated index or collinear corners; a mesh far larger than r or needing too many
+ * particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `vertices` must be NULL or point to 3·vertex_count readable floats; `indices` must be NULL or point to 3·triangle_count readable `uint32_t`s.
+ */
+enum PfStatus pf_world_add_mesh(struct PfWorld *world,
+                                const float *vertices,
+                                size_t vertex_count,
+                                const uint32_t *indices,
+                                size_t triangle_count);
+
+/**
  * Adds a closed box container from corner `min` to corner `max` (3 floats each, metres):
  * its six walls are sampled with boundary particles, `layers` (1–3) layers thick, growing
  * outward. Fluid farther than r/2 outside every container counts as escaped.

@@ -1,10 +1,12 @@
 //! Solid boundaries as static particles (Akinci et al. 2012): sampling of container walls and
-//! the boundary volumes ψ_b/ρ0 (ALGORITHM.md §2.6, §7).
+//! of triangle meshes ([`mesh`]), and the boundary volumes ψ_b/ρ0 (ALGORITHM.md §2.6, §7).
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;
 use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use rayon::prelude::*;
+
+pub mod mesh;
 
 /// An axis-aligned box, corners in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]

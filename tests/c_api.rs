@@ -147,6 +147,14 @@ fn misuse_is_rejected_with_status_and_message_leaving_the_world_unchanged() {
 }
 
 #[test]
+fn a_triangle_mesh_obstacle_becomes_boundary_particles_that_hold_the_fluid() {
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/mesh.c", link), &[]);
+        assert!(out.starts_with("mesh: ok"), "{link:?}: {out}");
+    }
+}
+
+#[test]
 fn distinct_worlds_step_in_parallel_and_one_world_reports_busy() {
     let out = run(&build("tests/c/parallel.c", Link::Shared), &["6"]);
     assert!(out.starts_with("parallel: ok"), "{out}");
@@ -266,6 +274,7 @@ fn c_tests_are_clean_under_valgrind() {
     for (source, args) in [
         ("tests/c/basic.c", &["2"][..]),
         ("tests/c/misuse.c", &[][..]),
+        ("tests/c/mesh.c", &["0.01"][..]),
         ("tests/c/parallel.c", &["2"][..]),
     ] {
         let program = build(source, Link::Static);

@@ -143,6 +143,11 @@ int main(void) {
     OK(pf_world_fluid_count(w, &n));
     CHECK(n == 27);
 
+    /* A small closed mesh, a tetrahedron of 8 cm sides beside the fluid. */
+    float mesh_v[12] = {0.2f, 0.02f, 0.2f, 0.28f, 0.02f, 0.2f,
+                        0.2f, 0.1f,  0.2f, 0.2f,  0.02f, 0.28f};
+    uint32_t mesh_i[12] = {0, 1, 2, 0, 1, 3, 0, 2, 3, 1, 2, 3};
+
     /* NULL world, for every function that takes one. */
     const float xyz[6] = {0.1f, 0.1f, 0.1f, 0.2f, 0.1f, 0.1f};
     float buf[3 * 27 + 8];
@@ -157,6 +162,7 @@ int main(void) {
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_box(NULL, start, count, NULL));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_boundary_particles(NULL, xyz, 2));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(NULL, lo, hi, 1));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_mesh(NULL, mesh_v, 4, mesh_i, 4));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_step(NULL, 0.0));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_advance(NULL, 0.01));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_count(NULL, &sz));
@@ -176,6 +182,10 @@ int main(void) {
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_fluid_box(w, start, NULL, NULL));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(w, NULL, hi, 1));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box(w, lo, NULL, 1));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_mesh(w, NULL, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "vertices") != NULL);
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_mesh(w, mesh_v, 4, NULL, 4));
+    CHECK(strstr(last_msg, "indices") != NULL);
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_count(w, NULL));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_boundary_count(w, NULL));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_time(w, NULL));
@@ -238,6 +248,41 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 0));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 4));
 
+    /* Bad meshes: zero and absurd counts, bad indices and vertices, degenerate triangles,
+     * a mesh far too large for the particle radius. */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 0, mesh_i, 4));
+    CHECK(strstr(last_msg, "vertex_count") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 0));
+    CHECK(strstr(last_msg, "triangle_count") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, NULL, 0, NULL, 0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, SIZE_MAX, mesh_i, 4));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, SIZE_MAX / 3));
+    mesh_i[7] = 4; /* triangle 2, corner 1: only vertices 0-3 exist */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "triangles[2][1]") != NULL && strstr(last_msg, "got 4") != NULL);
+    mesh_i[7] = UINT32_MAX;
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "triangles[2][1]") != NULL);
+    mesh_i[7] = 2;
+    mesh_v[10] = NAN; /* vertex 3, y */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "vertices[3]") != NULL && strstr(last_msg, "finite") != NULL);
+    mesh_v[10] = INFINITY;
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "vertices[3]") != NULL);
+    mesh_v[10] = 0.02f;
+    mesh_i[4] = 0; /* triangle 1 becomes {0, 0, 3} */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    CHECK(strstr(last_msg, "triangles[1]") != NULL && strstr(last_msg, "degenerate") != NULL);
+    mesh_i[4] = 1;
+    const float line_v[9] = {0.2f, 0.02f, 0.2f, 0.24f, 0.02f, 0.2f, 0.28f, 0.02f, 0.2f};
+    const uint32_t line_i[3] = {0, 1, 2}; /* collinear corners: zero area */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, line_v, 3, line_i, 1));
+    CHECK(strstr(last_msg, "triangles[0]") != NULL && strstr(last_msg, "collinear") != NULL);
+    const float huge_v[9] = {0.0f, 0.0f, 0.0f, 1000.0f, 0.0f, 0.0f, 0.0f, 0.0f, 1000.0f};
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_mesh(w, huge_v, 3, line_i, 1));
+    CHECK(strstr(last_msg, "mesh") != NULL);
+
     /* Bad step sizes and durations. */
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, NAN));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, INFINITY));
@@ -248,6 +293,11 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, INFINITY));
 
     /* Calls after all those failures work normally and clear the message. */
+    size_t nb = 0, nb_mesh = 0;
+    OK(pf_world_boundary_count(w, &nb));
+    OK(pf_world_add_mesh(w, mesh_v, 4, mesh_i, 4));
+    OK(pf_world_boundary_count(w, &nb_mesh));
+    CHECK(nb_mesh > nb + 10);
     OK(pf_world_add_fluid_particles(w, xyz, 2));
     OK(pf_world_fluid_count(w, &n));
     CHECK(n == 29);

@@ -158,15 +158,15 @@ typedef struct PfParams {
      */
     enum PfSolver solver;
     /**
-     * Rule for the first Chebyshev weight. Default `PF_OMEGA2_CHEBYSHEV`.
+     * Rule for the first Chebyshev weight. Default `PF_OMEGA2_SEED`.
      */
     enum PfOmega2Rule omega2_rule;
     /**
-     * Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.9.
+     * Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.85.
      */
     double chebyshev_rho;
     /**
-     * Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 3.
+     * Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
      */
     uint32_t chebyshev_delay;
     /**
@@ -179,7 +179,7 @@ typedef struct PfParams {
     enum PfProjectionWeight projection_weight;
     /**
      * Outer stopping threshold τ (m): stop when no particle moved more than τ in one
-     * outer iteration. Default 1e-3·r.
+     * outer iteration. Default 3e-3·r.
      */
     double displacement_tolerance;
     /**

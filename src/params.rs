@@ -85,16 +85,16 @@ pub struct ChebyshevParams {
 }
 
 /// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
-pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.9;
+pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.85;
 /// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
-pub const DEFAULT_CHEBYSHEV_DELAY: usize = 3;
+pub const DEFAULT_CHEBYSHEV_DELAY: usize = 1;
 
 impl Default for ChebyshevParams {
     fn default() -> Self {
         Self {
             rho: DEFAULT_CHEBYSHEV_RHO,
             delay: DEFAULT_CHEBYSHEV_DELAY,
-            omega2_rule: Omega2Rule::Chebyshev,
+            omega2_rule: Omega2Rule::SeedLiteral,
             gamma: 1.0,
         }
     }

@@ -63,18 +63,18 @@ pub struct PfParams {
     pub gravity: [f64; 3],
     /// The global solver. Default `PF_SOLVER_CHEBYSHEV`.
     pub solver: PfSolver,
-    /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_CHEBYSHEV`.
+    /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_SEED`.
     pub omega2_rule: PfOmega2Rule,
-    /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.9.
+    /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.85.
     pub chebyshev_rho: f64,
-    /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 3.
+    /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
     pub chebyshev_delay: u32,
     /// Under-relaxation γ of the Chebyshev step, in (0, 1]. Default 1.
     pub chebyshev_gamma: f64,
     /// Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
     pub projection_weight: PfProjectionWeight,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
-    /// outer iteration. Default 1e-3·r.
+    /// outer iteration. Default 3e-3·r.
     pub displacement_tolerance: f64,
     /// Smallest number of outer iterations per step (≥ 1). Default 1.
     pub min_outer_iterations: u32,

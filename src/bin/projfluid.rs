@@ -409,7 +409,7 @@ fn print_summary(s: &RunSummary) -> std::io::Result<()> {
         ("scene", s.scene.clone()),
         (
             "solver",
-            format!("{} (rho {}, tau {:e} m)", s.solver, s.rho, s.tau),
+            format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau),
         ),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),

@@ -122,7 +122,9 @@ impl UniformGrid {
         }
         order.clear();
         order.resize(points.len(), 0);
-        let mut cursor = starts[..self.cell_count()].to_vec();
+        let cursor = &mut table.cursor;
+        cursor.clear();
+        cursor.extend_from_slice(&starts[..self.cell_count()]);
         for (i, &r) in ranks.iter().enumerate() {
             let slot = &mut cursor[r as usize];
             order[*slot as usize] = i as u32;
@@ -208,6 +210,8 @@ impl UniformGrid {
 pub struct CellTable {
     cell_start: Vec<u32>,
     ranks: Vec<u32>,
+    /// Scratch of the counting sort: the next free slot of every cell.
+    cursor: Vec<u32>,
 }
 
 /// Neighbour lists in compressed form: the neighbours of query i are

@@ -17,16 +17,22 @@ pub fn sum<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync) -> f64 {
 
 /// max f(x) over `items` (−∞ for none); NaN values propagate as NaN.
 pub fn max<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync + Send) -> f64 {
-    items.par_iter().map(f).reduce(
-        || f64::NEG_INFINITY,
-        |a, b| {
-            if a.is_nan() || b.is_nan() {
-                f64::NAN
-            } else {
-                a.max(b)
-            }
-        },
-    )
+    max_over(items.len(), |i| f(&items[i]))
+}
+
+/// max f(i) for i in 0..n (−∞ for none); NaN values propagate as NaN.
+pub fn max_over(n: usize, f: impl Fn(usize) -> f64 + Sync + Send) -> f64 {
+    let nan_aware = |a: f64, b: f64| {
+        if a.is_nan() || b.is_nan() {
+            f64::NAN
+        } else {
+            a.max(b)
+        }
+    };
+    (0..n)
+        .into_par_iter()
+        .map(f)
+        .reduce(|| f64::NEG_INFINITY, nan_aware)
 }
 
 #[cfg(test)]

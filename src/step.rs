@@ -287,19 +287,7 @@ fn permute<T: Copy + Send + Sync + Default>(
 
 /// max_i |a_i − b_i| (m).
 fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
-    (0..a.len())
-        .into_par_iter()
-        .map(|i| (a[i] - b[i]).norm())
-        .reduce(
-            || 0.0,
-            |x, y| {
-                if x.is_nan() || y.is_nan() {
-                    f64::NAN
-                } else {
-                    x.max(y)
-                }
-            },
-        )
+    reduce::max_over(a.len(), |i| (a[i] - b[i]).norm())
 }
 
 /// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (ALGORITHM.md §1.3).

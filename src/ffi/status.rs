@@ -174,17 +174,19 @@ pub extern "C" fn pf_status_name(status: c_int) -> *const c_char {
     name.as_ptr().cast()
 }
 
+/// The calling thread's last error message, for tests.
+#[cfg(test)]
+pub(crate) fn message() -> String {
+    // SAFETY: the library returns a valid NUL-terminated string.
+    unsafe { std::ffi::CStr::from_ptr(pf_last_error_message()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use std::ffi::CStr;
-
-    fn message() -> String {
-        // SAFETY: the library returns a valid NUL-terminated string.
-        unsafe { CStr::from_ptr(pf_last_error_message()) }
-            .to_string_lossy()
-            .into_owned()
-    }
 
     #[test]
     fn panics_become_a_status_and_a_message() {

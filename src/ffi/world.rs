@@ -779,15 +779,8 @@ pub unsafe extern "C" fn pf_world_positions_hash(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ffi::{pf_last_error_message, pf_params_default};
-    use std::ffi::CStr;
-
-    fn message() -> String {
-        // SAFETY: the library returns a valid NUL-terminated string.
-        unsafe { CStr::from_ptr(pf_last_error_message()) }
-            .to_string_lossy()
-            .into_owned()
-    }
+    use crate::ffi::pf_params_default;
+    use crate::ffi::status::message;
 
     #[test]
     fn a_world_that_panicked_is_poisoned_until_destroyed() {

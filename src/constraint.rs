@@ -31,13 +31,6 @@ pub struct Neighborhood<'a> {
 }
 
 impl Neighborhood<'_> {
-    /// Start of particle i's stencil segment (centre, then its fluid neighbours) in a buffer
-    /// laid out like the neighbour lists with one extra slot per particle.
-    #[inline]
-    pub fn stencil_start(&self, i: usize) -> usize {
-        self.stencil_offsets[i] as usize
-    }
-
     /// Total length of a stencil buffer: one slot per particle and one per fluid pair.
     pub fn stencil_len(&self) -> usize {
         self.fluid.indices.len() + self.fluid.len()
@@ -129,7 +122,7 @@ impl DensityConstraint {
 
     /// The local step: projects every constraint i at the iterate `x`. Single-step projections
     /// (the usual case) keep only λ_i; longer ones write their stencil corrections
-    /// P_{i,j} − x_j (m) into `corrections` (layout of [`Neighborhood::stencil_start`]).
+    /// P_{i,j} − x_j (m) into `corrections` (segments given by [`Neighborhood::stencil_offsets`]).
     pub fn project(
         &self,
         x: &[Vec3],

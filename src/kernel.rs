@@ -53,29 +53,6 @@ impl CubicKernel {
         }
     }
 
-    /// W and ∇W together for `r = x_i − x_j` (metres): (1/m³, 1/m⁴), sharing one square root.
-    #[inline]
-    pub fn w_and_grad(&self, r: &Vec3) -> (f64, Vec3) {
-        let len = r.norm();
-        let q = len / self.support_radius;
-        if q > 1.0 {
-            return (0.0, Vec3::zeros());
-        }
-        let (w, shape) = if q <= 0.5 {
-            (
-                self.sigma * (6.0 * q * q * (q - 1.0) + 1.0),
-                q * (3.0 * q - 2.0),
-            )
-        } else {
-            let t = 1.0 - q;
-            (self.sigma * 2.0 * t * t * t, -t * t)
-        };
-        if len <= GRADIENT_CUTOFF {
-            return (w, Vec3::zeros());
-        }
-        (w, r * (self.gradient_factor * shape / len))
-    }
-
     /// ∇W with respect to the first argument of W(x_i − x_j), given `r = x_i − x_j` (metres),
     /// in 1/m⁴.
     #[inline]
@@ -173,17 +150,6 @@ mod tests {
             }
         }
         assert_eq!(kernel.grad_w(&Vec3::zeros()), Vec3::zeros());
-        for r in [
-            Vec3::new(0.01, 0.02, 0.0),
-            Vec3::new(0.0, 0.07, 0.01),
-            Vec3::zeros(),
-            Vec3::repeat(0.1),
-        ] {
-            assert_eq!(
-                kernel.w_and_grad(&r),
-                (kernel.w(r.norm()), kernel.grad_w(&r))
-            );
-        }
         assert_eq!(kernel.grad_w(&Vec3::new(0.2, 0.0, 0.0)), Vec3::zeros());
     }
 }

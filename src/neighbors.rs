@@ -63,11 +63,6 @@ impl UniformGrid {
         self.z_rank.len()
     }
 
-    /// Cell edge length in metres.
-    pub fn cell_size(&self) -> f64 {
-        self.cell_size
-    }
-
     /// True when every point lies inside the grid's domain, i.e. no point needs clamping.
     pub fn covers(&self, points: &[Vec3]) -> bool {
         let (lo, hi) = (self.origin, self.upper_corner());

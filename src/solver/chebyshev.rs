@@ -18,11 +18,6 @@ impl Chebyshev {
         Self { params, omega: 1.0 }
     }
 
-    /// The settings in use.
-    pub fn params(&self) -> &ChebyshevParams {
-        &self.params
-    }
-
     /// Restarts the recurrence (at the start of every time step).
     pub fn reset(&mut self) {
         self.omega = 1.0;

@@ -87,6 +87,18 @@ typedef enum PfSolver {
      * Jacobi sweeps until the residual drops by 1e-10 or 100 sweeps.
      */
     PF_SOLVER_JACOBI = 2,
+    /**
+     * Conjugate gradients until the residual drops by 1e-10 or 100 iterations.
+     */
+    PF_SOLVER_CG = 3,
+    /**
+     * Exactly one conjugate-gradient (steepest-descent) iteration per outer iteration.
+     */
+    PF_SOLVER_CG1 = 4,
+    /**
+     * Sparse LDLT factorisation once per time step, one direct solve per outer iteration.
+     */
+    PF_SOLVER_LDLT = 5,
 } PfSolver;
 
 /**

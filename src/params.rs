@@ -11,14 +11,24 @@ pub enum SolverKind {
     Jacobi1,
     /// Jacobi sweeps until ‖b − Ax‖ ≤ 1e-10‖b‖ or 100 sweeps.
     Jacobi,
+    /// Conjugate gradients until ‖b − Ax‖ ≤ 1e-10‖b‖ or 100 iterations.
+    Cg,
+    /// Exactly one conjugate-gradient iteration (a steepest-descent step with exact line
+    /// search) per outer iteration; not exact, so it changes the result.
+    Cg1,
+    /// Sparse LDLᵀ factorisation once per time step, one direct solve per outer iteration.
+    Ldlt,
 }
 
 impl SolverKind {
     /// Every solver, in the order the CLI lists them.
-    pub const ALL: [SolverKind; 3] = [
+    pub const ALL: [SolverKind; 6] = [
         SolverKind::Chebyshev,
         SolverKind::Jacobi1,
         SolverKind::Jacobi,
+        SolverKind::Cg,
+        SolverKind::Cg1,
+        SolverKind::Ldlt,
     ];
 
     /// The solver's name as used by the CLI, scenes and statistics.
@@ -27,6 +37,9 @@ impl SolverKind {
             SolverKind::Chebyshev => "chebyshev",
             SolverKind::Jacobi1 => "jacobi1",
             SolverKind::Jacobi => "jacobi",
+            SolverKind::Cg => "cg",
+            SolverKind::Cg1 => "cg1",
+            SolverKind::Ldlt => "ldlt",
         }
     }
 

@@ -15,6 +15,16 @@ pub fn sum<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync) -> f64 {
     partial.iter().sum()
 }
 
+/// Σ f(i) for i in 0..n, bitwise identical for any thread count (same chunks and order as
+/// [`sum`]); for sums over several slices at once, such as dot products.
+pub fn sum_over(n: usize, f: impl Fn(usize) -> f64 + Sync) -> f64 {
+    let partial: Vec<f64> = (0..n.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| (c * CHUNK..((c + 1) * CHUNK).min(n)).map(&f).sum())
+        .collect();
+    partial.iter().sum()
+}
+
 /// max f(x) over `items` (−∞ for none); NaN values propagate as NaN.
 pub fn max<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync + Send) -> f64 {
     max_over(items.len(), |i| f(&items[i]))
@@ -51,6 +61,8 @@ mod tests {
         };
         assert_eq!(run(1).to_bits(), run(4).to_bits());
         assert!((run(1) - values.iter().sum::<f64>()).abs() < 1e-6);
+        let over = super::sum_over(values.len(), |i| values[i]);
+        assert_eq!(over.to_bits(), run(1).to_bits());
         assert!(super::max(&[1.0, f64::NAN, 3.0], |v| *v).is_nan());
         assert_eq!(super::max(&[1.0, 5.0, 3.0], |v| *v), 5.0);
     }

@@ -1,7 +1,7 @@
 //! `projfluid`: runs a scene (built-in or JSON file) and reports how the solver did.
 //!
 //! ```text
-//! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi]
+//! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
 //! projfluid scenes
 //! ```
@@ -89,6 +89,12 @@ enum SolverArg {
     Jacobi1,
     /// Jacobi sweeps to convergence in every outer iteration.
     Jacobi,
+    /// Conjugate gradients to convergence in every outer iteration.
+    Cg,
+    /// Exactly one conjugate-gradient (steepest-descent) iteration per outer iteration.
+    Cg1,
+    /// Sparse LDLᵀ factorisation per time step, one direct solve per outer iteration.
+    Ldlt,
 }
 
 impl From<SolverArg> for SolverKind {
@@ -97,6 +103,9 @@ impl From<SolverArg> for SolverKind {
             SolverArg::Chebyshev => SolverKind::Chebyshev,
             SolverArg::Jacobi1 => SolverKind::Jacobi1,
             SolverArg::Jacobi => SolverKind::Jacobi,
+            SolverArg::Cg => SolverKind::Cg,
+            SolverArg::Cg1 => SolverKind::Cg1,
+            SolverArg::Ldlt => SolverKind::Ldlt,
         }
     }
 }

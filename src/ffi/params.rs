@@ -16,6 +16,12 @@ pub enum PfSolver {
     PF_SOLVER_JACOBI1 = 1,
     /// Jacobi sweeps until the residual drops by 1e-10 or 100 sweeps.
     PF_SOLVER_JACOBI = 2,
+    /// Conjugate gradients until the residual drops by 1e-10 or 100 iterations.
+    PF_SOLVER_CG = 3,
+    /// Exactly one conjugate-gradient (steepest-descent) iteration per outer iteration.
+    PF_SOLVER_CG1 = 4,
+    /// Sparse LDLT factorisation once per time step, one direct solve per outer iteration.
+    PF_SOLVER_LDLT = 5,
 }
 
 /// How the first Chebyshev weight ω₂ is chosen.
@@ -108,6 +114,9 @@ impl From<&Params> for PfParams {
                 SolverKind::Chebyshev => PfSolver::PF_SOLVER_CHEBYSHEV,
                 SolverKind::Jacobi1 => PfSolver::PF_SOLVER_JACOBI1,
                 SolverKind::Jacobi => PfSolver::PF_SOLVER_JACOBI,
+                SolverKind::Cg => PfSolver::PF_SOLVER_CG,
+                SolverKind::Cg1 => PfSolver::PF_SOLVER_CG1,
+                SolverKind::Ldlt => PfSolver::PF_SOLVER_LDLT,
             },
             omega2_rule: match p.chebyshev.omega2_rule {
                 Omega2Rule::Chebyshev => PfOmega2Rule::PF_OMEGA2_CHEBYSHEV,
@@ -155,6 +164,9 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         0 => SolverKind::Chebyshev,
         1 => SolverKind::Jacobi1,
         2 => SolverKind::Jacobi,
+        3 => SolverKind::Cg,
+        4 => SolverKind::Cg1,
+        5 => SolverKind::Ldlt,
         n => {
             return Err(Failure::invalid(format!(
                 "params->solver must be a PfSolver, got {n}"

@@ -72,6 +72,9 @@ enum SolverName {
     Chebyshev,
     Jacobi1,
     Jacobi,
+    Cg,
+    Cg1,
+    Ldlt,
 }
 
 /// `solver.omega2` values.
@@ -96,6 +99,9 @@ impl From<SolverName> for SolverKind {
             SolverName::Chebyshev => SolverKind::Chebyshev,
             SolverName::Jacobi1 => SolverKind::Jacobi1,
             SolverName::Jacobi => SolverKind::Jacobi,
+            SolverName::Cg => SolverKind::Cg,
+            SolverName::Cg1 => SolverKind::Cg1,
+            SolverName::Ldlt => SolverKind::Ldlt,
         }
     }
 }
@@ -106,6 +112,9 @@ impl From<SolverKind> for SolverName {
             SolverKind::Chebyshev => SolverName::Chebyshev,
             SolverKind::Jacobi1 => SolverName::Jacobi1,
             SolverKind::Jacobi => SolverName::Jacobi,
+            SolverKind::Cg => SolverName::Cg,
+            SolverKind::Cg1 => SolverName::Cg1,
+            SolverKind::Ldlt => SolverName::Ldlt,
         }
     }
 }

@@ -1,11 +1,15 @@
 //! The global step of the local/global iteration (ALGORITHM.md §3): the system matrix and the
 //! linear solvers behind one trait, plus Chebyshev's extrapolation over the outer iterations.
 
+mod cg;
 mod chebyshev;
 mod jacobi;
+mod ldlt;
 
+pub use cg::Cg;
 pub use chebyshev::Chebyshev;
 pub use jacobi::Jacobi;
+pub use ldlt::Ldlt;
 
 use crate::Vec3;
 use crate::params::SolverKind;
@@ -18,6 +22,12 @@ pub trait SystemMatrix: Sync {
     fn apply(&self, x: &[Vec3], out: &mut [Vec3]);
     /// The diagonal of Â (kg).
     fn diagonal(&self) -> &[f64];
+    /// Â assembled as compressed sparse rows `(row offsets, column indices, values)`, each
+    /// row's columns ascending, for the direct solvers; `None` (the default) when the matrix
+    /// is only available through its action.
+    fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
+        None
+    }
 }
 
 /// Formulation F1 (ALGORITHM.md §3.1): Â = diag(m + Δt²k(n_j + 1)), in kg.
@@ -36,6 +46,11 @@ impl SystemMatrix for DiagonalSystem {
 
     fn diagonal(&self) -> &[f64] {
         &self.diagonal
+    }
+
+    fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
+        let n = u32::try_from(self.diagonal.len()).ok()?;
+        Some(((0..=n).collect(), (0..n).collect(), self.diagonal.clone()))
     }
 }
 
@@ -57,6 +72,9 @@ pub fn linear_solver(kind: SolverKind) -> Box<dyn GlobalSolver> {
     match kind {
         SolverKind::Chebyshev | SolverKind::Jacobi1 => Box::new(Jacobi::single_sweep()),
         SolverKind::Jacobi => Box::new(Jacobi::converged()),
+        SolverKind::Cg => Box::new(Cg::converged()),
+        SolverKind::Cg1 => Box::new(Cg::single_iteration()),
+        SolverKind::Ldlt => Box::new(Ldlt::new()),
     }
 }
 
@@ -121,6 +139,20 @@ pub(crate) mod tests {
         fn diagonal(&self) -> &[f64] {
             &self.diag
         }
+        fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
+            let (mut offsets, mut cols, mut values) = (vec![0], Vec::new(), Vec::new());
+            for i in 0..self.n {
+                for j in 0..self.n {
+                    let a = self.a[i * self.n + j];
+                    if a != 0.0 {
+                        cols.push(j as u32);
+                        values.push(a);
+                    }
+                }
+                offsets.push(cols.len() as u32);
+            }
+            Some((offsets, cols, values))
+        }
     }
 
     pub fn rhs(n: usize) -> Vec<Vec3> {
@@ -137,5 +169,9 @@ pub(crate) mod tests {
         let mut out = vec![Vec3::zeros(); 2];
         sys.apply(&[Vec3::repeat(1.0), Vec3::new(1.0, 2.0, 3.0)], &mut out);
         assert_eq!(out, vec![Vec3::repeat(2.0), Vec3::new(3.0, 6.0, 9.0)]);
+        assert_eq!(
+            sys.assemble(),
+            Some((vec![0, 1, 2], vec![0, 1], vec![2.0, 3.0]))
+        );
     }
 }

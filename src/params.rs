@@ -31,8 +31,19 @@ impl SolverKind {
         SolverKind::Ldlt,
     ];
 
+    /// Every solver's name, in the order of [`SolverKind::ALL`].
+    pub const NAMES: [&'static str; 6] = {
+        let mut names = [""; 6];
+        let mut i = 0;
+        while i < names.len() {
+            names[i] = Self::ALL[i].name();
+            i += 1;
+        }
+        names
+    };
+
     /// The solver's name as used by the CLI, scenes and statistics.
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             SolverKind::Chebyshev => "chebyshev",
             SolverKind::Jacobi1 => "jacobi1",
@@ -46,6 +57,21 @@ impl SolverKind {
     /// Parses a solver name (see [`SolverKind::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
         Self::ALL.into_iter().find(|k| k.name() == name)
+    }
+}
+
+/// Scene files write a solver as its name.
+impl serde::Serialize for SolverKind {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+/// Scene files name a solver; an unknown name is an error listing the known ones.
+impl<'de> serde::Deserialize<'de> for SolverKind {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        Self::from_name(&name).ok_or_else(|| serde::de::Error::unknown_variant(&name, &Self::NAMES))
     }
 }
 

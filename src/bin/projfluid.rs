@@ -8,7 +8,8 @@
 //!
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
 
-use clap::{Args, Parser, Subcommand, ValueEnum};
+use clap::builder::{PossibleValuesParser, TypedValueParser};
+use clap::{Args, Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use projfluid::io::write_vtk;
 use projfluid::scene::Scene;
@@ -57,9 +58,9 @@ struct RunArgs {
     /// Number of time steps to run, instead of a duration.
     #[arg(long, value_name = "N")]
     steps: Option<u64>,
-    /// Global solver.
-    #[arg(long, value_enum)]
-    solver: Option<SolverArg>,
+    /// Global solver (the README's "Command line" section describes each).
+    #[arg(long, value_parser = solver_parser())]
+    solver: Option<SolverKind>,
     /// Chebyshev spectral radius estimate ρ_c, in [0, 1).
     #[arg(long, value_name = "R", allow_negative_numbers = true)]
     rho: Option<f64>,
@@ -80,42 +81,19 @@ struct RunArgs {
     stats: Option<PathBuf>,
 }
 
-/// `--solver` values.
-#[derive(Clone, Copy, ValueEnum)]
-enum SolverArg {
-    /// One Jacobi sweep per outer iteration with Chebyshev extrapolation.
-    Chebyshev,
-    /// Exactly one Jacobi sweep per outer iteration.
-    Jacobi1,
-    /// Jacobi sweeps to convergence in every outer iteration.
-    Jacobi,
-    /// Conjugate gradients to convergence in every outer iteration.
-    Cg,
-    /// Exactly one conjugate-gradient (steepest-descent) iteration per outer iteration.
-    Cg1,
-    /// Sparse LDLᵀ factorisation per time step, one direct solve per outer iteration.
-    Ldlt,
-}
-
-impl From<SolverArg> for SolverKind {
-    fn from(s: SolverArg) -> Self {
-        match s {
-            SolverArg::Chebyshev => SolverKind::Chebyshev,
-            SolverArg::Jacobi1 => SolverKind::Jacobi1,
-            SolverArg::Jacobi => SolverKind::Jacobi,
-            SolverArg::Cg => SolverKind::Cg,
-            SolverArg::Cg1 => SolverKind::Cg1,
-            SolverArg::Ldlt => SolverKind::Ldlt,
-        }
-    }
-}
-
 /// Why the program stops early; decides the exit code.
 enum Failure {
     /// Bad scene or option (exit 2).
     Input(String),
     /// The run itself failed, e.g. output could not be written (exit 1).
     Runtime(String),
+}
+
+/// `--solver`: one of [`SolverKind::NAMES`], shown as the possible values.
+fn solver_parser() -> impl TypedValueParser<Value = SolverKind> {
+    PossibleValuesParser::new(SolverKind::NAMES).try_map(|name| {
+        SolverKind::from_name(&name).ok_or_else(|| format!("unknown solver `{name}`"))
+    })
 }
 
 fn main() -> ExitCode {
@@ -255,7 +233,7 @@ fn run(args: &RunArgs) -> Result<(), Failure> {
 fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure> {
     let p = &mut scene.params;
     if let Some(s) = args.solver {
-        p.solver = s.into();
+        p.solver = s;
     }
     if let Some(rho) = args.rho {
         p.chebyshev.rho = rho;

@@ -36,7 +36,7 @@ struct SceneFile {
 #[derive(Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 struct SolverFile {
-    kind: Option<SolverName>,
+    kind: Option<SolverKind>,
     rho: Option<f64>,
     delay: Option<usize>,
     omega2: Option<Omega2Name>,
@@ -65,18 +65,6 @@ struct OutputFile {
     every: Option<usize>,
 }
 
-/// `solver.kind` values.
-#[derive(Serialize, Deserialize, Clone, Copy)]
-#[serde(rename_all = "lowercase")]
-enum SolverName {
-    Chebyshev,
-    Jacobi1,
-    Jacobi,
-    Cg,
-    Cg1,
-    Ldlt,
-}
-
 /// `solver.omega2` values.
 #[derive(Serialize, Deserialize, Clone, Copy)]
 #[serde(rename_all = "lowercase")]
@@ -91,32 +79,6 @@ enum Omega2Name {
 enum WeightName {
     NeighborCount,
     Unit,
-}
-
-impl From<SolverName> for SolverKind {
-    fn from(n: SolverName) -> Self {
-        match n {
-            SolverName::Chebyshev => SolverKind::Chebyshev,
-            SolverName::Jacobi1 => SolverKind::Jacobi1,
-            SolverName::Jacobi => SolverKind::Jacobi,
-            SolverName::Cg => SolverKind::Cg,
-            SolverName::Cg1 => SolverKind::Cg1,
-            SolverName::Ldlt => SolverKind::Ldlt,
-        }
-    }
-}
-
-impl From<SolverKind> for SolverName {
-    fn from(k: SolverKind) -> Self {
-        match k {
-            SolverKind::Chebyshev => SolverName::Chebyshev,
-            SolverKind::Jacobi1 => SolverName::Jacobi1,
-            SolverKind::Jacobi => SolverName::Jacobi,
-            SolverKind::Cg => SolverName::Cg,
-            SolverKind::Cg1 => SolverName::Cg1,
-            SolverKind::Ldlt => SolverName::Ldlt,
-        }
-    }
 }
 
 impl From<Omega2Name> for Omega2Rule {
@@ -249,7 +211,7 @@ impl SceneFile {
         set(&mut p.viscosity, self.viscosity);
         p.threads = self.threads.unwrap_or(p.threads);
         let s = self.solver.unwrap_or_default();
-        p.solver = s.kind.map_or(p.solver, SolverKind::from);
+        p.solver = s.kind.unwrap_or(p.solver);
         let c: &mut ChebyshevParams = &mut p.chebyshev;
         set(&mut c.rho, s.rho);
         c.delay = s.delay.unwrap_or(c.delay);
@@ -296,7 +258,7 @@ impl SceneFile {
             container: Some(Containers(scene.containers.clone())),
             fluid_blocks: scene.fluid_blocks.clone(),
             solver: Some(SolverFile {
-                kind: Some(p.solver.into()),
+                kind: Some(p.solver),
                 rho: Some(c.rho),
                 delay: Some(c.delay),
                 omega2: Some(c.omega2_rule.into()),

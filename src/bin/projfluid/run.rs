@@ -1,15 +1,7 @@
-//! `projfluid`: runs a scene (built-in or JSON file) and reports how the solver did.
-//!
-//! ```text
-//! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
-//!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
-//! projfluid scenes
-//! ```
-//!
-//! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
+//! `projfluid run`: one scene, with progress, frames and a summary.
 
-use clap::builder::{PossibleValuesParser, TypedValueParser};
-use clap::{Args, Parser, Subcommand};
+use crate::{Failure, solver_parser};
+use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use projfluid::io::write_vtk;
 use projfluid::scene::Scene;
@@ -18,33 +10,11 @@ use projfluid::{Error, SolverKind, World};
 use std::fs::File;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 use std::time::Instant;
-
-/// Command line.
-#[derive(Parser)]
-#[command(
-    name = "projfluid",
-    version,
-    about = "Projective-fluids SPH solver with Chebyshev acceleration"
-)]
-struct Cli {
-    #[command(subcommand)]
-    command: Command,
-}
-
-/// Subcommands.
-#[derive(Subcommand)]
-enum Command {
-    /// Run a scene and print a summary of the run.
-    Run(RunArgs),
-    /// List the built-in scenes.
-    Scenes,
-}
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
 #[derive(Args)]
-struct RunArgs {
+pub(crate) struct RunArgs {
     /// A built-in scene name (see `projfluid scenes`) or the path of a JSON scene file.
     scene: String,
     /// Simulated time to run, in seconds [default: the scene's duration].
@@ -81,57 +51,6 @@ struct RunArgs {
     stats: Option<PathBuf>,
 }
 
-/// Why the program stops early; decides the exit code.
-enum Failure {
-    /// Bad scene or option (exit 2).
-    Input(String),
-    /// The run itself failed, e.g. output could not be written (exit 1).
-    Runtime(String),
-}
-
-/// `--solver`: one of [`SolverKind::NAMES`], shown as the possible values.
-fn solver_parser() -> impl TypedValueParser<Value = SolverKind> {
-    PossibleValuesParser::new(SolverKind::NAMES).try_map(|name| {
-        SolverKind::from_name(&name).ok_or_else(|| format!("unknown solver `{name}`"))
-    })
-}
-
-fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
-        Command::Run(args) => run(&args),
-        Command::Scenes => list_scenes(),
-    };
-    match result {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Input(msg)) => {
-            eprintln!("error: {msg}");
-            ExitCode::from(2)
-        }
-        Err(Failure::Runtime(msg)) => {
-            eprintln!("error: {msg}");
-            ExitCode::from(1)
-        }
-    }
-}
-
-/// `projfluid scenes`: one line per built-in scene.
-fn list_scenes() -> Result<(), Failure> {
-    let mut out = std::io::stdout().lock();
-    for name in Scene::builtin_names() {
-        if let Some(scene) = Scene::builtin(name) {
-            let line = format!(
-                "{name:<20} {:>8} particles  {:>5} s simulated\n",
-                scene.particle_count(),
-                scene.duration
-            );
-            out.write_all(line.as_bytes())
-                .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))?;
-        }
-    }
-    Ok(())
-}
-
 /// How long to run.
 #[derive(Clone, Copy)]
 enum Target {
@@ -142,7 +61,7 @@ enum Target {
 }
 
 /// `projfluid run`.
-fn run(args: &RunArgs) -> Result<(), Failure> {
+pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
     let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     let target = apply_overrides(&mut scene, args)?;
     let mut world = scene

@@ -22,6 +22,7 @@ pub mod io;
 pub mod kernel;
 pub mod neighbors;
 pub mod params;
+pub mod plot;
 pub mod reduce;
 pub mod scene;
 pub mod solver;

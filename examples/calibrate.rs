@@ -18,7 +18,11 @@ fn main() {
     let seconds: f64 = a[1].parse().expect("seconds");
     let p = &mut scene.params;
     p.solver = SolverKind::from_name(&a[2]).expect("solver");
-    p.chebyshev.rho = a[3].parse().expect("rho");
+    if a[3] == "auto" {
+        p.chebyshev.auto_rho = true;
+    } else {
+        p.chebyshev.rho = a[3].parse().expect("rho");
+    }
     p.chebyshev.delay = a[4].parse().expect("delay");
     p.chebyshev.omega2_rule = Omega2Rule::from_name(&a[5]).expect("omega2");
     p.displacement_tolerance = a[6].parse::<f64>().expect("tau") * p.particle_radius;
@@ -36,10 +40,11 @@ fn main() {
     }
     let s = acc.summary(&a[0], &world);
     println!(
-        "{{\"scene\":\"{}\",\"solver\":\"{}\",\"rho\":{},\"delay\":{},\"omega2\":\"{}\",\"tau_per_r\":{},\"steps\":{},\"outer_mean\":{:.3},\"ms_per_step\":{:.2},\"err_avg_pct\":{:.5},\"err_max_pct\":{:.3},\"energy_rise_j\":{:.4},\"energy_end_j\":{:.3},\"e0\":{:.3},\"kmax_hits\":{},\"escaped\":{},\"nan\":{}}}",
+        "{{\"scene\":\"{}\",\"solver\":\"{}\",\"rho\":\"{}\",\"rho_mean\":{:.3},\"delay\":{},\"omega2\":\"{}\",\"tau_per_r\":{},\"steps\":{},\"outer_mean\":{:.3},\"ms_per_step\":{:.2},\"err_avg_pct\":{:.5},\"err_max_pct\":{:.3},\"energy_rise_j\":{:.4},\"energy_end_j\":{:.3},\"e0\":{:.3},\"kmax_hits\":{},\"escaped\":{},\"nan\":{}}}",
         a[0],
         a[2],
         a[3],
+        s.rho,
         a[4],
         a[5],
         a[6],

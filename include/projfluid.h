@@ -186,6 +186,11 @@ typedef struct PfParams {
      */
     double chebyshev_gamma;
     /**
+     * 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
+     * value); 0: use `chebyshev_rho` throughout. Default 0.
+     */
+    uint32_t chebyshev_auto_rho;
+    /**
      * Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
      */
     enum PfProjectionWeight projection_weight;

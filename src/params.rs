@@ -121,6 +121,10 @@ pub struct ChebyshevParams {
     pub omega2_rule: Omega2Rule,
     /// Under-relaxation γ in (0, 1].
     pub gamma: f64,
+    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every 20th step runs
+    /// the plain iteration and measures its contraction ρ̂, and ρ_c = 0.9·ρ̂ (smoothed, clamped
+    /// to [0.5, 0.95]); `rho` is only the value used until the first estimate.
+    pub auto_rho: bool,
 }
 
 /// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
@@ -135,6 +139,7 @@ impl Default for ChebyshevParams {
             delay: DEFAULT_CHEBYSHEV_DELAY,
             omega2_rule: Omega2Rule::SeedLiteral,
             gamma: 1.0,
+            auto_rho: false,
         }
     }
 }

@@ -448,6 +448,29 @@ mod tests {
     }
 
     #[test]
+    fn rho_auto_is_read_written_and_checked() {
+        let auto = GOOD.replacen(
+            "\"fluid_blocks\"",
+            "\"solver\": {\"rho\": \"auto\"}, \"fluid_blocks\"",
+            1,
+        );
+        let scene = Scene::from_json(&auto).unwrap();
+        assert!(scene.params.chebyshev.auto_rho);
+        let again = Scene::from_json(&scene.to_json()).unwrap();
+        assert_eq!(again.params, scene.params);
+        assert!(!Scene::from_json(GOOD).unwrap().params.chebyshev.auto_rho);
+        let bad = GOOD.replacen(
+            "\"fluid_blocks\"",
+            "\"solver\": {\"rho\": \"fast\"}, \"fluid_blocks\"",
+            1,
+        );
+        assert_names(
+            &message(Scene::from_json(&bad)),
+            &["solver.rho", "fast", "\"auto\""],
+        );
+    }
+
+    #[test]
     fn bad_values_name_the_json_key() {
         let cases = [
             (

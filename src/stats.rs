@@ -1,6 +1,6 @@
 //! Per-step statistics and the run summary that the CLI prints and writes as `--stats` JSON.
 
-use crate::World;
+use crate::{SolverKind, World};
 use serde::Serialize;
 
 /// Wall-clock seconds spent in the parts of one step.
@@ -27,6 +27,9 @@ pub struct StepStats {
     pub inner_iterations: usize,
     /// The outer loop ended at its iteration limit instead of the displacement rule.
     pub hit_max_iterations: bool,
+    /// Chebyshev's ρ_c in this step (the online estimate with `auto_rho`); 0 when the step did
+    /// not extrapolate (other solvers, probe steps of the online estimate).
+    pub rho: f64,
     /// Largest particle displacement in the last outer iteration (m).
     pub last_displacement: f64,
     /// Mean compression max(ρ/ρ0 − 1, 0) over fluid particles after the step (fraction).
@@ -44,8 +47,11 @@ pub struct RunSummary {
     pub scene: String,
     /// Global solver name.
     pub solver: String,
-    /// Chebyshev ρ_c (reported for every solver; used by `chebyshev` only).
+    /// Chebyshev ρ_c (reported for every solver; used by `chebyshev` only); with `rho_auto`,
+    /// the mean online estimate over the steps that extrapolated.
     pub rho: f64,
+    /// ρ_c was estimated online (`--rho auto`).
+    pub rho_auto: bool,
     /// Outer stopping threshold τ (m).
     pub tau: f64,
     /// Worker threads.
@@ -85,6 +91,8 @@ pub struct RunAccumulator {
     outer: u64,
     density_avg_sum: f64,
     density_max: f64,
+    rho_sum: f64,
+    rho_steps: u64,
     breakdown: [f64; 4],
 }
 
@@ -95,6 +103,10 @@ impl RunAccumulator {
         self.sim_time += step.dt;
         self.wall_seconds += wall_seconds;
         self.outer += step.outer_iterations as u64;
+        if step.rho > 0.0 {
+            self.rho_sum += step.rho;
+            self.rho_steps += 1;
+        }
         self.density_avg_sum += step.density_error_avg;
         self.density_max = self.density_max.max(step.density_error_max);
         let t = &step.timings;
@@ -119,7 +131,13 @@ impl RunAccumulator {
         RunSummary {
             scene: scene.to_string(),
             solver: p.solver.name().to_string(),
-            rho: p.chebyshev.rho,
+            rho: if p.chebyshev.auto_rho && p.solver == SolverKind::Chebyshev && self.rho_steps > 0
+            {
+                self.rho_sum / self.rho_steps as f64
+            } else {
+                p.chebyshev.rho
+            },
+            rho_auto: p.chebyshev.auto_rho,
             tau: p.displacement_tolerance,
             threads: world.thread_count(),
             particles: world.fluid_count(),

@@ -178,7 +178,8 @@ impl World {
                 stencil_offsets: &b.stencil_offsets,
             };
             chebyshev.reset();
-            let accelerate = params.solver == SolverKind::Chebyshev;
+            let chebyshev_step = params.solver == SolverKind::Chebyshev;
+            let accelerate = chebyshev_step && chebyshev.accelerates();
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
             b.displacements.clear();
             while outer < params.max_outer_iterations {
@@ -208,6 +209,7 @@ impl World {
                 }
                 displacement = max_distance(&b.next, &b.current);
                 b.displacements.push(displacement);
+
                 // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
                 std::mem::swap(&mut b.previous, &mut b.current);
                 std::mem::swap(&mut b.current, &mut b.next);
@@ -221,6 +223,10 @@ impl World {
                 }
             }
 
+            let rho = if accelerate { chebyshev.rho() } else { 0.0 };
+            if chebyshev_step {
+                chebyshev.finish_step(&b.displacements);
+            }
             // 5. Velocity update v = (x^{n+1} − x^n)/Δt, then the new positions.
             let t = Instant::now();
             fluid
@@ -246,6 +252,7 @@ impl World {
                 outer_iterations: outer,
                 inner_iterations: inner,
                 hit_max_iterations: displacement >= params.displacement_tolerance,
+                rho,
                 last_displacement: displacement,
                 density_error_avg,
                 density_error_max,

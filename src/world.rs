@@ -308,6 +308,27 @@ impl World {
         out
     }
 
+    /// Replaces every fluid velocity (m/s), given in the order the particles were added.
+    /// Rejects a length mismatch or a non-finite value without changing the world.
+    pub fn set_velocities(&mut self, velocities: &[Vec3]) -> Result<(), Error> {
+        if velocities.len() != self.fluid_count() {
+            return Err(Error::invalid(
+                "velocities",
+                velocities.len(),
+                &format!(
+                    "must have one entry per fluid particle ({})",
+                    self.fluid_count()
+                ),
+            ));
+        }
+        check_finite("velocities", velocities)?;
+        let fluid = &mut self.fluid;
+        for (v, &id) in fluid.velocities.iter_mut().zip(&fluid.ids) {
+            *v = velocities[id as usize];
+        }
+        Ok(())
+    }
+
     /// Fluid densities (kg/m³) after the last step, in the order the particles were added
     /// (zero before the first step).
     pub fn densities(&self) -> Vec<f64> {
@@ -569,5 +590,35 @@ impl World {
         }
         let samples = sample_poisson_disk(mesh, r);
         self.add_boundary_particles(&samples)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::boundary::Aabb;
+
+    /// Velocities set in insertion order come back in insertion order after the particles
+    /// were re-sorted by a step; bad input changes nothing.
+    #[test]
+    fn set_velocities_uses_insertion_order_and_rejects_bad_input() {
+        let mut world = World::new(Params::default()).unwrap();
+        let container = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(0.5),
+        };
+        world.add_container(container, 1).unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(0.1), [3, 2, 2], Vec3::zeros())
+            .unwrap();
+        world.step().unwrap();
+        let wanted: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f64, 0.5, -1.0)).collect();
+        world.set_velocities(&wanted).unwrap();
+        assert_eq!(world.velocities(), wanted);
+        assert!(world.set_velocities(&wanted[..11]).is_err());
+        let mut bad = wanted.clone();
+        bad[3].y = f64::NAN;
+        assert!(world.set_velocities(&bad).is_err());
+        assert_eq!(world.velocities(), wanted);
     }
 }

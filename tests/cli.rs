@@ -109,8 +109,9 @@ fn missing_scenes_exit_2() {
 
 #[test]
 fn bad_option_values_exit_2_naming_option_and_value() {
-    let cases: [(&[&str], &[&str]); 6] = [
+    let cases: [(&[&str], &[&str]); 7] = [
         (&["--rho", "1.5"], &["--rho", "1.5"]),
+        (&["--rho", "fast"], &["--rho", "fast", "auto"]),
         (&["--tau", "-1"], &["--tau", "-1"]),
         (&["--every", "0"], &["--every", "0"]),
         (&["--steps", "0"], &["--steps", "0"]),
@@ -259,4 +260,29 @@ fn scenes_lists_builtins_with_particle_counts() {
         stdout.contains("dam_break_30k") && stdout.contains("30000"),
         "{stdout}"
     );
+}
+
+/// `--rho auto` estimates ρ_c online: the summary and the stats say so and report the mean
+/// estimate, which lies in the clamped range rather than at the starting value.
+#[test]
+fn rho_auto_runs_and_reports_its_estimate() {
+    let dir = temp_dir("rho-auto");
+    let stats = dir.join("stats.json");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "60",
+        "--rho",
+        "auto",
+        "--stats",
+        stats.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0), "{out:?}");
+    assert!(String::from_utf8_lossy(&out.stdout).contains("rho auto"));
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(json["rho_auto"], true);
+    let rho = json["rho"].as_f64().unwrap();
+    assert!((0.5..=0.95).contains(&rho) && rho != 0.85, "mean rho {rho}");
 }

@@ -168,24 +168,36 @@ fn chebyshev_with_zero_rho_is_the_plain_iteration() {
 
 /// At its default ρ, Chebyshev needs fewer outer iterations than the plain iteration (at least
 /// 5 % fewer; 12.5 % when the defaults were chosen — the small scene iterates little at the
-/// default τ, the 30k dam break saves 40 %).
+/// default τ, the 30k dam break saves 40 %). With ρ estimated online (`--rho auto`) it needs
+/// no more than the plain iteration and keeps the density error bound.
 #[test]
 fn chebyshev_needs_fewer_outer_iterations_than_plain() {
-    let mean_iterations = |solver| {
-        let mut world = small_dam_break(solver, None, 0);
-        let (mut total, mut steps) = (0, 0);
+    let mean_iterations = |solver, auto_rho| {
+        let mut scene = Scene::builtin("dam_break_small").expect("built-in scene");
+        scene.params.solver = solver;
+        scene.params.chebyshev.auto_rho = auto_rho;
+        let mut world = scene.build_world().expect("world");
+        let (mut total, mut steps, mut error) = (0, 0, 0.0);
         run(&mut world, 1.0, |w| {
-            total += w.last_step().unwrap().outer_iterations;
+            let step = w.last_step().unwrap();
+            total += step.outer_iterations;
+            error += step.density_error_avg;
             steps += 1;
         });
-        total as f64 / steps as f64
+        (total as f64 / steps as f64, error / steps as f64)
     };
-    let plain = mean_iterations(SolverKind::Jacobi1);
-    let accelerated = mean_iterations(SolverKind::Chebyshev);
+    let (plain, _) = mean_iterations(SolverKind::Jacobi1, false);
+    let (accelerated, _) = mean_iterations(SolverKind::Chebyshev, false);
     assert!(
         accelerated < 0.95 * plain,
         "chebyshev {accelerated:.2} vs plain {plain:.2} outer iterations per step"
     );
+    let (auto, auto_error) = mean_iterations(SolverKind::Chebyshev, true);
+    assert!(
+        auto <= plain,
+        "chebyshev with rho auto {auto:.2} vs plain {plain:.2} outer iterations per step"
+    );
+    assert!(auto_error <= 1e-3, "average density error {auto_error}");
 }
 
 /// The global solvers that solve A·x = b (exactly or to 1e-10) give the same physics on the

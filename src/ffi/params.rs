@@ -77,6 +77,9 @@ pub struct PfParams {
     pub chebyshev_delay: u32,
     /// Under-relaxation γ of the Chebyshev step, in (0, 1]. Default 1.
     pub chebyshev_gamma: f64,
+    /// 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
+    /// value); 0: use `chebyshev_rho` throughout. Default 0.
+    pub chebyshev_auto_rho: u32,
     /// Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
     pub projection_weight: PfProjectionWeight,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
@@ -125,6 +128,7 @@ impl From<&Params> for PfParams {
             chebyshev_rho: p.chebyshev.rho,
             chebyshev_delay: small(p.chebyshev.delay),
             chebyshev_gamma: p.chebyshev.gamma,
+            chebyshev_auto_rho: u32::from(p.chebyshev.auto_rho),
             projection_weight: match p.projection_weight {
                 ProjectionWeight::NeighborCount => PfProjectionWeight::PF_WEIGHT_NEIGHBOR_COUNT,
                 ProjectionWeight::Unit => PfProjectionWeight::PF_WEIGHT_UNIT,
@@ -191,6 +195,15 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
             )));
         }
     };
+    let auto_rho = match field!(chebyshev_auto_rho) {
+        0 => false,
+        1 => true,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->chebyshev_auto_rho must be 0 or 1, got {n}"
+            )));
+        }
+    };
     let count = |n: u32| n as usize;
     let params = Params {
         particle_radius: field!(particle_radius),
@@ -204,6 +217,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
             delay: count(field!(chebyshev_delay)),
             omega2_rule,
             gamma: field!(chebyshev_gamma),
+            auto_rho,
         },
         displacement_tolerance: field!(displacement_tolerance),
         min_outer_iterations: count(field!(min_outer_iterations)),

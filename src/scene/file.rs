@@ -37,7 +37,7 @@ struct SceneFile {
 #[serde(deny_unknown_fields)]
 struct SolverFile {
     kind: Option<SolverKind>,
-    rho: Option<f64>,
+    rho: Option<RhoSetting>,
     delay: Option<usize>,
     omega2: Option<Omega2Name>,
     gamma: Option<f64>,
@@ -63,6 +63,50 @@ struct TimeFile {
 struct OutputFile {
     dir: Option<String>,
     every: Option<usize>,
+}
+
+/// `solver.rho`: a number in [0, 1), or `"auto"` for the online estimate.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum RhoSetting {
+    Value(f64),
+    Auto,
+}
+
+impl Serialize for RhoSetting {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        match self {
+            RhoSetting::Value(v) => s.serialize_f64(*v),
+            RhoSetting::Auto => s.serialize_str("auto"),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for RhoSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = RhoSetting;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number in [0, 1) or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<RhoSetting, E> {
+                Ok(RhoSetting::Value(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<RhoSetting, E> {
+                Ok(RhoSetting::Value(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<RhoSetting, E> {
+                Ok(RhoSetting::Value(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(self, v: &str) -> Result<RhoSetting, E> {
+                match v {
+                    "auto" => Ok(RhoSetting::Auto),
+                    _ => Err(E::invalid_value(serde::de::Unexpected::Str(v), &self)),
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// `solver.omega2` values.
@@ -213,7 +257,11 @@ impl SceneFile {
         let s = self.solver.unwrap_or_default();
         p.solver = s.kind.unwrap_or(p.solver);
         let c: &mut ChebyshevParams = &mut p.chebyshev;
-        set(&mut c.rho, s.rho);
+        match s.rho {
+            Some(RhoSetting::Value(v)) => c.rho = v,
+            Some(RhoSetting::Auto) => c.auto_rho = true,
+            None => {}
+        }
         c.delay = s.delay.unwrap_or(c.delay);
         c.omega2_rule = s.omega2.map_or(c.omega2_rule, Omega2Rule::from);
         set(&mut c.gamma, s.gamma);
@@ -259,7 +307,11 @@ impl SceneFile {
             fluid_blocks: scene.fluid_blocks.clone(),
             solver: Some(SolverFile {
                 kind: Some(p.solver),
-                rho: Some(c.rho),
+                rho: Some(if c.auto_rho {
+                    RhoSetting::Auto
+                } else {
+                    RhoSetting::Value(c.rho)
+                }),
                 delay: Some(c.delay),
                 omega2: Some(c.omega2_rule.into()),
                 gamma: Some(c.gamma),

@@ -1,36 +1,76 @@
 //! Chebyshev semi-iterative acceleration of the outer local/global iteration
-//! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]).
+//! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]), with a fixed ρ_c or one estimated online
+//! (§5.3, [`ChebyshevParams::auto_rho`]).
 
 use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
 use rayon::prelude::*;
 
-/// The ω recurrence of one time step.
+/// With `auto_rho`, every this many steps one step runs the plain iteration (a probe) to
+/// measure its contraction.
+pub const AUTO_PROBE_INTERVAL: u64 = 20;
+/// A probe needs at least this many outer iterations to give an estimate.
+pub const AUTO_MIN_PROBE_ITERATIONS: usize = 20;
+/// ρ_c = κ·ρ̂ with ρ̂ the smoothed contraction of the probes (README, "Choosing ρ").
+pub const AUTO_KAPPA: f64 = 0.9;
+/// Weight of a new probe's contraction in the exponential moving average ρ̂.
+pub const AUTO_SMOOTHING: f64 = 0.5;
+/// Range that the online ρ_c is clamped to.
+pub const AUTO_RHO_RANGE: (f64, f64) = (0.5, 0.95);
+
+/// The ω recurrence of one time step, and the online ρ_c estimate carried across steps.
 #[derive(Clone, Debug)]
 pub struct Chebyshev {
     params: ChebyshevParams,
     omega: f64,
+    /// ρ_c of the current step.
+    rho: f64,
+    /// Smoothed plain-iteration contraction ρ̂ (online mode), once measured.
+    contraction: Option<f64>,
+    /// Steps since the last successful probe.
+    since_probe: u64,
+    /// The current step is a probe: plain iteration, no extrapolation.
+    probing: bool,
 }
 
 impl Chebyshev {
     /// A recurrence with the given settings, ready for the first outer iteration.
     pub fn new(params: ChebyshevParams) -> Self {
-        Self { params, omega: 1.0 }
+        let mut c = Self {
+            params,
+            omega: 1.0,
+            rho: params.rho,
+            contraction: None,
+            since_probe: AUTO_PROBE_INTERVAL,
+            probing: false,
+        };
+        c.reset();
+        c
     }
 
-    /// Restarts the recurrence (at the start of every time step).
+    /// Restarts the recurrence at the start of every time step and, with `auto_rho`, decides
+    /// whether this step is a probe: the first step, then every [`AUTO_PROBE_INTERVAL`] steps.
     pub fn reset(&mut self) {
         self.omega = 1.0;
+        self.probing = self.params.auto_rho && self.since_probe >= AUTO_PROBE_INTERVAL;
+    }
+
+    /// True when the current step extrapolates (false during a probe).
+    pub fn accelerates(&self) -> bool {
+        !self.probing
+    }
+
+    /// ρ_c that the current step extrapolates with.
+    pub fn rho(&self) -> f64 {
+        self.rho
     }
 
     /// ω_{k+1}, the weight that produces X^(k+1) in outer iteration `k` (k = 0, 1, …).
     pub fn next_weight(&mut self, k: usize) -> f64 {
         let ChebyshevParams {
-            rho,
-            delay,
-            omega2_rule,
-            ..
+            delay, omega2_rule, ..
         } = self.params;
+        let rho = self.rho;
         self.omega = if k < delay {
             1.0
         } else if k == delay {
@@ -42,6 +82,33 @@ impl Chebyshev {
             4.0 / (4.0 - rho * rho * self.omega)
         };
         self.omega
+    }
+
+    /// Online mode only: learns from the displacements δ_0..δ_K of the step just finished.
+    /// After a probe with at least [`AUTO_MIN_PROBE_ITERATIONS`] iterations, the contraction
+    /// (δ_K/δ_h)^(1/(K−h)) over the last half (h = ⌊(K+1)/2⌋) enters ρ̂ ← (1 − a)ρ̂ + a·rate
+    /// and ρ_c = clamp(κ·ρ̂); a shorter probe leaves ρ_c as it was (the starting `rho` until
+    /// the first estimate).
+    pub fn finish_step(&mut self, displacements: &[f64]) {
+        if !self.params.auto_rho {
+            return;
+        }
+        if !self.probing {
+            self.since_probe += 1;
+            return;
+        }
+        // Whether or not it measured something, the next probe comes an interval later.
+        self.since_probe = 0;
+        let Some(rate) = late_contraction(displacements) else {
+            return;
+        };
+        let smoothed = match self.contraction {
+            Some(c) => c + AUTO_SMOOTHING * (rate - c),
+            None => rate,
+        };
+        self.contraction = Some(smoothed);
+        let (lo, hi) = AUTO_RHO_RANGE;
+        self.rho = (AUTO_KAPPA * smoothed).clamp(lo, hi);
     }
 
     /// Turns the plain iterate X̃^(k+1) in `next` into
@@ -65,6 +132,18 @@ impl Chebyshev {
     }
 }
 
+/// Geometric-mean ratio of successive displacements over the last half of `displacements`,
+/// or `None` when there are fewer than [`AUTO_MIN_PROBE_ITERATIONS`] or they are not positive.
+fn late_contraction(displacements: &[f64]) -> Option<f64> {
+    let n = displacements.len();
+    if n < AUTO_MIN_PROBE_ITERATIONS {
+        return None;
+    }
+    let (first, last) = (displacements[n / 2], displacements[n - 1]);
+    let rate = (last / first).powf(1.0 / (n - 1 - n / 2) as f64);
+    (first > 0.0 && last > 0.0 && rate.is_finite()).then(|| rate.min(1.0))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -75,6 +154,7 @@ mod tests {
             delay,
             omega2_rule: rule,
             gamma: 1.0,
+            auto_rho: false,
         }
     }
 
@@ -120,5 +200,49 @@ mod tests {
         let accelerated = iterations(0.9);
         assert!(plain > 200, "{plain}");
         assert!(accelerated < plain / 3, "{accelerated} vs {plain}");
+    }
+
+    #[test]
+    fn online_rho_comes_from_probes_of_the_plain_iteration() {
+        let mut c = Chebyshev::new(ChebyshevParams {
+            auto_rho: true,
+            ..params(0.85, 1, Omega2Rule::SeedLiteral)
+        });
+        // Probe every AUTO_PROBE_INTERVAL steps, starting with the first.
+        let next_probe = |c: &mut Chebyshev| {
+            for _ in 0..AUTO_PROBE_INTERVAL {
+                c.reset();
+                assert!(c.accelerates());
+                c.finish_step(&[1.0, 0.1]);
+            }
+            c.reset();
+            assert!(!c.accelerates());
+        };
+        assert!(!c.accelerates());
+        // Too short to measure: the starting ρ_c stays.
+        c.finish_step(&[1.0, 0.5, 0.2]);
+        assert_eq!(c.rho(), 0.85);
+        next_probe(&mut c);
+        // Twenty iterations contracting at 0.9.
+        let probe: Vec<f64> = (0..20).map(|k| 0.9f64.powi(k)).collect();
+        c.finish_step(&probe);
+        let first = AUTO_KAPPA * 0.9;
+        assert!((c.rho() - first).abs() < 1e-12, "{}", c.rho());
+        c.reset();
+        assert!(c.accelerates());
+        assert_eq!(c.next_weight(0), 1.0);
+        assert_eq!(c.next_weight(1), 4.0 / (4.0 - first * first));
+        // The next probe is smoothed in.
+        next_probe(&mut c);
+        let probe: Vec<f64> = (0..22).map(|k| 0.99f64.powi(k)).collect();
+        c.finish_step(&probe);
+        let smoothed = 0.9 + AUTO_SMOOTHING * (0.99 - 0.9);
+        let expected = (AUTO_KAPPA * smoothed).clamp(AUTO_RHO_RANGE.0, AUTO_RHO_RANGE.1);
+        assert!((c.rho() - expected).abs() < 1e-12);
+        // A fixed ρ_c never probes.
+        let mut fixed = Chebyshev::new(params(0.85, 1, Omega2Rule::SeedLiteral));
+        assert!(fixed.accelerates());
+        fixed.finish_step(&probe);
+        assert_eq!(fixed.rho(), 0.85);
     }
 }

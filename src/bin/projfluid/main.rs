@@ -2,7 +2,7 @@
 //!
 //! ```text
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
-//!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
+//!                     [--rho R|auto] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
 //! projfluid scenes
 //! ```
 //!
@@ -52,6 +52,38 @@ pub(crate) fn solver_parser() -> impl TypedValueParser<Value = SolverKind> {
     PossibleValuesParser::new(SolverKind::NAMES).try_map(|name| {
         SolverKind::from_name(&name).ok_or_else(|| format!("unknown solver `{name}`"))
     })
+}
+
+/// A `--rho` value: a fixed ρ_c or `auto` (estimated online).
+#[derive(Clone, Copy, Debug)]
+pub(crate) enum RhoArg {
+    /// Use this ρ_c throughout.
+    Fixed(f64),
+    /// Estimate ρ_c online.
+    Auto,
+}
+
+impl RhoArg {
+    /// Applies the choice to Chebyshev settings.
+    pub(crate) fn apply(self, c: &mut projfluid::ChebyshevParams) {
+        match self {
+            RhoArg::Fixed(rho) => {
+                c.rho = rho;
+                c.auto_rho = false;
+            }
+            RhoArg::Auto => c.auto_rho = true,
+        }
+    }
+}
+
+/// `--rho`: a number or `auto`.
+pub(crate) fn rho_parser(text: &str) -> Result<RhoArg, String> {
+    if text == "auto" {
+        return Ok(RhoArg::Auto);
+    }
+    text.parse::<f64>()
+        .map(RhoArg::Fixed)
+        .map_err(|_| format!("expected a number in [0, 1) or `auto`, got `{text}`"))
 }
 
 fn main() -> ExitCode {

@@ -1,6 +1,6 @@
 //! `projfluid run`: one scene, with progress, frames and a summary.
 
-use crate::{Failure, solver_parser};
+use crate::{Failure, RhoArg, rho_parser, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use projfluid::io::write_vtk;
@@ -31,9 +31,9 @@ pub(crate) struct RunArgs {
     /// Global solver (the README's "Command line" section describes each).
     #[arg(long, value_parser = solver_parser())]
     solver: Option<SolverKind>,
-    /// Chebyshev spectral radius estimate ρ_c, in [0, 1).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
-    rho: Option<f64>,
+    /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
+    #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
+    rho: Option<RhoArg>,
     /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     tau: Option<f64>,
@@ -155,7 +155,7 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure>
         p.solver = s;
     }
     if let Some(rho) = args.rho {
-        p.chebyshev.rho = rho;
+        rho.apply(&mut p.chebyshev);
     }
     if let Some(tau) = args.tau {
         p.displacement_tolerance = tau;
@@ -315,7 +315,14 @@ fn print_summary(s: &RunSummary) -> std::io::Result<()> {
         ("scene", s.scene.clone()),
         (
             "solver",
-            format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau),
+            if s.rho_auto {
+                format!(
+                    "{} (rho auto, mean {:.3}; tau {:.3e} m)",
+                    s.solver, s.rho, s.tau
+                )
+            } else {
+                format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau)
+            },
         ),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),

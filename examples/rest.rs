@@ -1,0 +1,165 @@
+//! Resting-column experiment (README, Known limitations): RMS velocity, centre of mass and
+//! outer iterations over time for the 12 × 16 × 12 column of the physics tests.
+//!
+//! `cargo run --release --example rest -- TAU_PER_R SOLVER RHO SECONDS PRINT_EVERY GAP_PER_R`
+//! (defaults 3e-3 chebyshev 0.85 2 0.1 2.25). Environment: `SETTLE=s` first runs s seconds with
+//! velocities scaled by `DAMP` (default 0) after every step; `XSPH`, `DTMAX`, `K` override the
+//! viscosity, Δt_max and stiffness; `LAYERS`, `DISP`, `DUMP` print velocity by region,
+//! displacement per initial layer and the last step's δ_k.
+use projfluid::{boundary::Aabb, *};
+fn main() {
+    let a: Vec<String> = std::env::args().collect();
+    let arg = |i: usize, d: &str| a.get(i).cloned().unwrap_or(d.to_string());
+    let tau_r: f64 = arg(1, "3e-3").parse().unwrap();
+    let solver = SolverKind::from_name(&arg(2, "chebyshev")).unwrap();
+    let rho: f64 = arg(3, "0.85").parse().unwrap();
+    let secs: f64 = arg(4, "2").parse().unwrap();
+    let mut params = Params {
+        mass_factor: 1.0,
+        solver,
+        ..Params::default()
+    };
+    params.chebyshev.rho = rho;
+    if let Ok(v) = std::env::var("XSPH") {
+        params.viscosity = v.parse().unwrap();
+    }
+    if let Ok(v) = std::env::var("DTMAX") {
+        params.dt_max = v.parse().unwrap();
+    }
+    if let Ok(v) = std::env::var("K") {
+        params.stiffness = v.parse().unwrap();
+    }
+    params.displacement_tolerance = tau_r * params.particle_radius;
+    let (r, d) = (params.particle_radius, params.spacing());
+    let mut world = World::new(params).unwrap();
+    let n = [12usize, 16, 12];
+    let gap_r: f64 = arg(6, "2.25").parse().unwrap();
+    let gap = gap_r * r;
+    let floor = d - gap;
+    let inner = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
+    world
+        .add_container(
+            Aabb {
+                min: Vec3::repeat(floor),
+                max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
+            },
+            1,
+        )
+        .unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
+        .unwrap();
+    let step_out: f64 = arg(5, "0.1").parse().unwrap();
+    let initial = world.positions();
+    let settle: f64 = std::env::var("SETTLE")
+        .map(|v| v.parse().unwrap())
+        .unwrap_or(0.0);
+    while world.time() < settle - 1e-9 {
+        world.step().unwrap();
+        let f: f64 = std::env::var("DAMP")
+            .map(|v| v.parse().unwrap())
+            .unwrap_or(0.0);
+        let z: Vec<Vec3> = world.velocities().iter().map(|v| v * f).collect();
+        world.set_velocities(&z).unwrap();
+    }
+    let secs = secs + settle;
+    println!(
+        "settled {settle} s, ycom {:.6}",
+        world.positions().iter().map(|p| p.y).sum::<f64>() / world.fluid_count() as f64
+    );
+    let mut next = settle + step_out;
+    let (mut it, mut steps) = (0usize, 0usize);
+    while world.time() < secs - 1e-9 {
+        let s = world.step().unwrap().clone();
+        it += s.outer_iterations;
+        steps += 1;
+        if world.time() >= next - 1e-9 {
+            let dl = world.last_displacements();
+            let k = dl.len();
+            let ratio = if k >= 3 {
+                dl[k - 1] / dl[k - 2]
+            } else {
+                f64::NAN
+            };
+            let vy: f64 =
+                world.velocities().iter().map(|v| v.y).sum::<f64>() / world.fluid_count() as f64;
+            let ycom: f64 =
+                world.positions().iter().map(|p| p.y).sum::<f64>() / world.fluid_count() as f64;
+            print!("ycom {:.6} epot {:.3} ", ycom, world.potential_energy());
+            println!(
+                "t {:.2} rms {:.4} vy_mean {:+.5} dt {:.4} it/step {:.1} last_ratio {:.3} err {:.4}% ek {:.3e}",
+                world.time(),
+                world.rms_velocity(),
+                vy,
+                s.dt,
+                it as f64 / steps as f64,
+                ratio,
+                s.density_error_avg * 100.0,
+                world.kinetic_energy()
+            );
+            next += step_out;
+            if std::env::var("LAYERS").is_ok() {
+                let (ps, vs) = (world.positions(), world.velocities());
+                let top = ps.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+                let mut acc = [[0.0f64; 3]; 3];
+                for (p, v) in ps.iter().zip(vs.iter()) {
+                    let c = if p.y > top - 0.08 {
+                        0
+                    } else if p.y < 0.1 {
+                        2
+                    } else {
+                        1
+                    };
+                    acc[c][0] += v.x * v.x + v.z * v.z;
+                    acc[c][1] += v.y * v.y;
+                    acc[c][2] += 1.0;
+                }
+                for (c, name) in ["top", "bulk", "bottom"].iter().enumerate() {
+                    print!(
+                        "  {name}: horiz {:.4} vert {:.4} n {}",
+                        (acc[c][0] / acc[c][2]).sqrt(),
+                        (acc[c][1] / acc[c][2]).sqrt(),
+                        acc[c][2]
+                    );
+                }
+                println!();
+            }
+            if std::env::var("DISP").is_ok() {
+                let ps = world.positions();
+                let mut acc = vec![(0.0f64, 0.0f64, 0usize); 16];
+                for (p, p0) in ps.iter().zip(initial.iter()) {
+                    let l = ((p0.y - d) / d).round() as usize;
+                    let dp = p - p0;
+                    acc[l].0 += dp.y;
+                    acc[l].1 += (dp.x * dp.x + dp.z * dp.z).sqrt();
+                    acc[l].2 += 1;
+                }
+                for (l, a) in acc.iter().enumerate() {
+                    print!(
+                        "L{l}: dy {:+.4} dh {:.4} | ",
+                        a.0 / a.2 as f64,
+                        a.1 / a.2 as f64
+                    );
+                    if l % 4 == 3 {
+                        println!();
+                    }
+                }
+            }
+            if std::env::var("DUMP").is_ok() {
+                println!(
+                    "{:?}",
+                    world
+                        .last_displacements()
+                        .iter()
+                        .map(|x| format!("{:.2e}", x))
+                        .collect::<Vec<_>>()
+                );
+            }
+            it = 0;
+            steps = 0;
+        }
+    }
+}
+// (diagnostic) δ_k sequence of the last step, printed when DUMP is set.
+#[allow(dead_code)]
+fn unused() {}

@@ -18,6 +18,7 @@
 //! ```
 
 use crate::Error;
+use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::Path;
@@ -200,15 +201,23 @@ impl LineChart {
                 });
         }
         let corner = emptiest_corner(self.series.iter().flat_map(|s| s.points.iter()), x, y);
-        chart
-            .configure_series_labels()
-            .position(corner)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())
+        draw_legend(&mut chart, corner)
     }
+}
+
+/// Draws the legend of `chart` in `corner`.
+fn draw_legend<'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    corner: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(corner)
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 /// The corner of the plot whose quarter-size box holds the fewest points: where the legend
@@ -336,14 +345,7 @@ impl BarChart {
             .flat_map(|(i, &v)| [(i as f64, v), (i as f64, 0.0)])
             .collect();
         let corner = emptiest_corner(ends.iter(), (-0.5, n as f64 - 0.5), y);
-        chart
-            .configure_series_labels()
-            .position(corner)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())
+        draw_legend(&mut chart, corner)
     }
 }
 

@@ -3,7 +3,7 @@
 
 use projfluid::SolverKind;
 use projfluid::validation::hydrostatic;
-use projfluid::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Setup};
+use projfluid::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
 use projfluid::validation::reference::Measurements;
 use std::path::PathBuf;
 use std::process::Command;
@@ -51,38 +51,36 @@ fn assert_matches_martin_moyce(solver: SolverKind) {
         a.simulated
     );
     assert_eq!(cmp.front.len(), 15);
-    for row in &cmp.front {
-        let err = row
-            .relative_error()
-            .expect("the run covers every tabulated T");
-        assert!(
-            err.abs() <= 0.10,
-            "{}: front at T = {}: Z = {:.3} simulated, {} measured ({:+.1} %)",
-            solver.name(),
-            row.time,
-            row.simulated.unwrap(),
-            row.measured,
-            100.0 * err
-        );
-    }
-    let compared: Vec<_> = cmp
+    assert!(
+        cmp.front.iter().all(|r| r.simulated.is_some()),
+        "the run must cover every tabulated T"
+    );
+    assert_within_10_percent(solver, "front at T", "Z", &cmp.front);
+    let compared: Vec<Row> = cmp
         .height
         .iter()
         .filter(|r| r.simulated.is_some())
+        .copied()
         .collect();
     assert!(
         compared.len() >= 12,
         "only {} heights compared",
         compared.len()
     );
-    for row in compared {
-        let err = row.relative_error().unwrap();
+    assert_within_10_percent(solver, "residual height at tau", "H", &compared);
+}
+
+/// Every simulated row of `rows` within 10 % of the measurement.
+fn assert_within_10_percent(solver: SolverKind, what: &str, symbol: &str, rows: &[Row]) {
+    for row in rows {
+        let (Some(sim), Some(err)) = (row.simulated, row.relative_error()) else {
+            continue;
+        };
         assert!(
             err.abs() <= 0.10,
-            "{}: residual height at tau = {}: H = {:.3} simulated, {} measured ({:+.1} %)",
+            "{}: {what} = {}: {symbol} = {sim:.3} simulated, {} measured ({:+.1} %)",
             solver.name(),
             row.time,
-            row.simulated.unwrap(),
             row.measured,
             100.0 * err
         );
@@ -136,7 +134,7 @@ fn tank_at_rest_keeps_density_and_height() {
 }
 
 /// The pressure read from the constraint multipliers grows linearly with depth, like
-/// ρ0·g·(H − y), below one support radius from the surface.
+/// ρ0·g·(H − y), more than one support radius from the surface and the floor.
 #[test]
 fn tank_at_rest_pressure_has_the_hydrostatic_shape() {
     let r = settled_tank();
@@ -158,7 +156,7 @@ fn tank_at_rest_pressure_has_the_hydrostatic_shape() {
 /// −dp/dy within 10 % of ρ0·g.
 #[test]
 #[ignore = "open: the outer iteration stops short of its fixed point, so the constraint forces at \
-            the end of a step carry ≈4.8× the weight in this tank and the slope is ≈4.8 ρ0·g \
+            the end of a step carry ≈4.8× the weight in this tank and the slope is ≈5.9 ρ0·g \
             (README, Validation)"]
 fn tank_at_rest_pressure_has_the_hydrostatic_magnitude() {
     let r = settled_tank();
@@ -244,7 +242,7 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 7] = [
+    let cases: [&[&str]; 8] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
         &[
             "validate",
@@ -278,6 +276,14 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
             "--out",
             out_dir,
         ],
+        &[
+            "validate",
+            "hydrostatic",
+            "--count",
+            "5,5",
+            "--out",
+            out_dir,
+        ],
         &["validate", "hydrostatic", "--tau", "0", "--out", out_dir],
         &["validate", "nonsense"],
     ];
@@ -287,14 +293,8 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
         assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
         assert!(stderr.contains("error"), "{args:?}: {stderr}");
     }
-    let out = projfluid(&[
-        "validate",
-        "martin-moyce",
-        "--resolution",
-        "2",
-        "--out",
-        out_dir,
-    ]);
+    // The message names the option.
+    let out = projfluid(cases[1]);
     assert!(String::from_utf8_lossy(&out.stderr).contains("--resolution"));
     assert!(
         !dir.exists(),

@@ -146,8 +146,9 @@ pub struct Report {
     /// Layer means over particles at least one support radius from the side walls, averaged
     /// over the steps of the last quarter second.
     pub profile: Vec<Layer>,
-    /// Least-squares slope −dp/dy of the layer means at least one support radius below the
-    /// surface (Pa/m); ρ0·g for a hydrostatic column.
+    /// Least-squares slope −dp/dy of the layer means at least one support radius from the
+    /// surface and the floor, where particle pressures under-read (Pa/m); ρ0·g for a
+    /// hydrostatic column.
     pub slope: f64,
     /// ρ0·g (Pa/m).
     pub hydrostatic_slope: f64,
@@ -238,12 +239,12 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         .collect();
     let fitted: Vec<(f64, f64)> = profile
         .iter()
-        .filter(|l| l.height <= datum - h_support)
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
         .map(|l| (l.height, l.pressure))
         .collect();
     let shape: Vec<(f64, f64)> = profile
         .iter()
-        .filter(|l| l.height <= datum - h_support)
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
         .map(|l| (l.pressure, l.hydrostatic))
         .collect();
     Ok(Report {

@@ -20,6 +20,20 @@ pub(crate) enum ValidateCommand {
     Hydrostatic(HydrostaticArgs),
 }
 
+/// Options every validation takes.
+#[derive(Args)]
+pub(crate) struct CommonArgs {
+    /// Global solver.
+    #[arg(long, value_parser = solver_parser(), default_value = "chebyshev")]
+    solver: SolverKind,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N", default_value_t = 0)]
+    threads: usize,
+    /// Directory for the CSV and PNG files, created if missing.
+    #[arg(long, value_name = "DIR", default_value = "validation")]
+    out: PathBuf,
+}
+
 /// Options of `projfluid validate martin-moyce`.
 #[derive(Args)]
 pub(crate) struct MartinMoyceArgs {
@@ -35,15 +49,8 @@ pub(crate) struct MartinMoyceArgs {
     /// Dimensionless duration tau = t·√(g/a) [default: 3.0 for n² = 2, 3.5 for n² = 1].
     #[arg(long, value_name = "TAU", allow_negative_numbers = true)]
     duration: Option<f64>,
-    /// Global solver.
-    #[arg(long, value_parser = solver_parser(), default_value = "chebyshev")]
-    solver: SolverKind,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    threads: usize,
-    /// Directory for the CSV and PNG files, created if missing.
-    #[arg(long, value_name = "DIR", default_value = "validation")]
-    out: PathBuf,
+    #[command(flatten)]
+    common: CommonArgs,
 }
 
 /// Options of `projfluid validate hydrostatic`.
@@ -54,8 +61,7 @@ pub(crate) struct HydrostaticArgs {
         long,
         value_name = "NX,NY,NZ",
         default_value = "12,16,12",
-        value_delimiter = ',',
-        num_args = 3
+        value_delimiter = ','
     )]
     count: Vec<usize>,
     /// Settling time in seconds.
@@ -69,15 +75,8 @@ pub(crate) struct HydrostaticArgs {
     /// Outer stopping threshold τ in metres [default: 3e-3·r].
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     tau: Option<f64>,
-    /// Global solver.
-    #[arg(long, value_parser = solver_parser(), default_value = "chebyshev")]
-    solver: SolverKind,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N", default_value_t = 0)]
-    threads: usize,
-    /// Directory for the CSV and PNG files, created if missing.
-    #[arg(long, value_name = "DIR", default_value = "validation")]
-    out: PathBuf,
+    #[command(flatten)]
+    common: CommonArgs,
 }
 
 /// `projfluid validate …`.
@@ -117,8 +116,8 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
     let mut setup = martin_moyce::Setup::new(args.n2);
     setup.particles_across = args.resolution;
     setup.layers = args.layers;
-    setup.solver = args.solver;
-    setup.threads = args.threads;
+    setup.solver = args.common.solver;
+    setup.threads = args.common.threads;
     if let Some(d) = args.duration {
         setup.duration = d;
     }
@@ -129,7 +128,7 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
         other => input(other),
     })?;
     let data = Measurements::for_ratio(args.n2).map_err(runtime)?;
-    create_dir(&args.out)?;
+    create_dir(&args.common.out)?;
     let (a, d) = (
         projfluid::validation::reference::COLUMN_WIDTH,
         setup.spacing(),
@@ -148,7 +147,7 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
     let clock = Instant::now();
     let run = martin_moyce::simulate(&setup, |_| {}).map_err(runtime)?;
     let cmp = martin_moyce::compare(&run, &data).map_err(input)?;
-    let files = martin_moyce::write_report(&args.out, &run, &data, &cmp).map_err(runtime)?;
+    let files = martin_moyce::write_report(&args.common.out, &run, &data, &cmp).map_err(runtime)?;
     let mut text = format!(
         "{} fluid particles, {} boundary particles, {} steps in {:.1} s; max compression {:.3} %, \
          {} escaped\n",
@@ -174,13 +173,23 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
 
 fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
     let mut setup = hydrostatic::Setup {
-        solver: args.solver,
-        threads: args.threads,
+        solver: args.common.solver,
+        threads: args.common.threads,
         settle: args.settle,
         tolerance: args.tau,
         ..hydrostatic::Setup::default()
     };
-    setup.count = [args.count[0], args.count[1], args.count[2]];
+    setup.count = match args.count[..] {
+        [x, y, z] => [x, y, z],
+        _ => {
+            let given = format!("{:?}", args.count);
+            return Err(input(Error::invalid(
+                "--count",
+                given,
+                "must be three numbers NX,NY,NZ",
+            )));
+        }
+    };
     setup.validate().map_err(|e| match e {
         Error::InvalidArgument { field, message } => {
             Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
@@ -196,9 +205,9 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
             )));
         }
     }
-    create_dir(&args.out)?;
+    create_dir(&args.common.out)?;
     let report = hydrostatic::simulate(&setup, |_| {}).map_err(runtime)?;
-    let files = hydrostatic::write_report(&args.out, &report).map_err(runtime)?;
+    let files = hydrostatic::write_report(&args.common.out, &report).map_err(runtime)?;
     let text = format!(
         "{}\nwrote {}, {}\n",
         report.text(),

@@ -301,3 +301,62 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
         "a rejected command must not create its output directory"
     );
 }
+
+#[test]
+fn cli_hydrostatic_writes_its_profile_and_chart() {
+    let dir = scratch("cli_hydrostatic");
+    let out = projfluid(&[
+        "validate",
+        "hydrostatic",
+        "--count",
+        "4,5,4",
+        "--settle",
+        "0.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in [
+        "density error",
+        "rms velocity",
+        "N·V/area",
+        "pressure slope",
+        "force / weight",
+    ] {
+        assert!(stdout.contains(key), "`{key}` missing:\n{stdout}");
+    }
+    let png = std::fs::read(dir.join("hydrostatic_pressure.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let csv = std::fs::read_to_string(dir.join("hydrostatic_profile.csv")).unwrap();
+    assert!(
+        csv.starts_with("height_m,pressure_pa,hydrostatic_pa,particles\n"),
+        "{csv}"
+    );
+}
+
+#[test]
+fn cli_validate_exits_1_when_the_output_cannot_be_written() {
+    let dir = scratch("blocked");
+    std::fs::create_dir_all(&dir).unwrap();
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "not a directory").unwrap();
+    let out = projfluid(&[
+        "validate",
+        "martin-moyce",
+        "--resolution",
+        "4",
+        "--out",
+        blocker.join("sub").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("cannot create output directory"),
+        "{stderr}"
+    );
+}

@@ -28,6 +28,7 @@ pub mod scene;
 pub mod solver;
 pub mod stats;
 mod step;
+pub mod validation;
 mod world;
 
 pub use error::Error;

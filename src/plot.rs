@@ -18,6 +18,7 @@
 //! ```
 
 use crate::Error;
+use plotters::coord::CoordTranslate;
 use plotters::prelude::*;
 use plotters::style::{FontStyle, register_font};
 use std::path::Path;
@@ -158,13 +159,15 @@ impl LineChart {
             .caption(&self.title, (FONT, 22))
             .margin(12)
             .x_label_area_size(45)
-            .y_label_area_size(65)
+            .y_label_area_size(80)
             .build_cartesian_2d(x.0..x.1, y.0..y.1)
             .map_err(|e| e.to_string())?;
         chart
             .configure_mesh()
             .x_desc(&self.x_label)
             .y_desc(&self.y_label)
+            .x_label_formatter(&|v| tick(*v, x.1 - x.0))
+            .y_label_formatter(&|v| tick(*v, y.1 - y.0))
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
             .light_line_style(RGBColor(235, 235, 235))
@@ -198,15 +201,23 @@ impl LineChart {
                 });
         }
         let corner = emptiest_corner(self.series.iter().flat_map(|s| s.points.iter()), x, y);
-        chart
-            .configure_series_labels()
-            .position(corner)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())
+        draw_legend(&mut chart, corner)
     }
+}
+
+/// Draws the legend of `chart` in `corner`.
+fn draw_legend<'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, BitMapBackend<'a>, CT>,
+    corner: SeriesLabelPosition,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(corner)
+        .label_font((FONT, 14))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(|e| e.to_string())
 }
 
 /// The corner of the plot whose quarter-size box holds the fewest points: where the legend
@@ -286,7 +297,7 @@ impl BarChart {
             .caption(&self.title, (FONT, 22))
             .margin(12)
             .x_label_area_size(40)
-            .y_label_area_size(65)
+            .y_label_area_size(80)
             .build_cartesian_2d(-0.5..n as f64 - 0.5, y.0..y.1)
             .map_err(|e| e.to_string())?;
         // Category i is centred on x = i; ticks fall on the integers.
@@ -304,6 +315,7 @@ impl BarChart {
             .x_labels(n)
             .x_label_formatter(&name)
             .y_desc(&self.y_label)
+            .y_label_formatter(&|v| tick(*v, y.1 - y.0))
             .label_style((FONT, 14))
             .axis_desc_style((FONT, 16))
             .light_line_style(RGBColor(235, 235, 235))
@@ -333,15 +345,20 @@ impl BarChart {
             .flat_map(|(i, &v)| [(i as f64, v), (i as f64, 0.0)])
             .collect();
         let corner = emptiest_corner(ends.iter(), (-0.5, n as f64 - 0.5), y);
-        chart
-            .configure_series_labels()
-            .position(corner)
-            .label_font((FONT, 14))
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(|e| e.to_string())
+        draw_legend(&mut chart, corner)
     }
+}
+
+/// An axis tick label on an axis spanning `span`: the value rounded to 9 significant digits
+/// (hiding binary round-off such as 0.30000000000000004), in the shortest form that reads
+/// back the same; values within 1e-9·span of zero read "0".
+fn tick(v: f64, span: f64) -> String {
+    if v.abs() <= 1e-9 * span || !v.is_finite() {
+        return "0".into();
+    }
+    let rounded: f64 = format!("{v:.8e}").parse().unwrap_or(v);
+    let text = format!("{rounded}");
+    if text == "-0" { "0".into() } else { text }
 }
 
 type Area<'a> = DrawingArea<BitMapBackend<'a>, plotters::coord::Shift>;
@@ -371,6 +388,7 @@ fn encode_png(rgb: &[u8]) -> Result<Vec<u8>, png::EncodingError> {
     let mut encoder = png::Encoder::new(&mut out, WIDTH, HEIGHT);
     encoder.set_color(png::ColorType::Rgb);
     encoder.set_depth(png::BitDepth::Eight);
+    encoder.set_compression(png::Compression::Best);
     let mut writer = encoder.write_header()?;
     writer.write_image_data(rgb)?;
     writer.finish()?;
@@ -410,6 +428,16 @@ fn padded_range(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tick_labels_are_short() {
+        assert_eq!(tick(0.1 + 0.2, 1.0), "0.3");
+        assert_eq!(tick(90000.0, 1e5), "90000");
+        assert_eq!(tick(-0.0, 1.0), "0");
+        assert_eq!(tick(-1.25, 1.0), "-1.25");
+        assert_eq!(tick(5.5e-17, 1.0), "0");
+        assert_eq!(tick(2e-12, 1e-11), "0.000000000002");
+    }
 
     #[test]
     fn padded_range_handles_single_values_and_zero() {

@@ -4,12 +4,17 @@
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R|auto] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
 //! projfluid scenes
+//! projfluid validate martin-moyce [--n2 2|1] [--resolution N] [--layers N] [--duration TAU]
+//!                                 [--solver S] [--threads N] [--out DIR]
+//! projfluid validate hydrostatic [--count NX,NY,NZ] [--settle SECONDS] [--tau METRES]
+//!                                [--solver S] [--threads N] [--out DIR]
 //! ```
 //!
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
 //! Each subcommand lives in its own module.
 
 mod run;
+mod validate;
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
@@ -37,6 +42,9 @@ enum Command {
     Run(run::RunArgs),
     /// List the built-in scenes.
     Scenes,
+    /// Compare the solver with experiment and analytic solutions (writes CSV and PNG files).
+    #[command(subcommand)]
+    Validate(validate::ValidateCommand),
 }
 
 /// Why the program stops early; decides the exit code.
@@ -91,6 +99,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => run::run(&args),
         Command::Scenes => list_scenes(),
+        Command::Validate(command) => validate::validate(&command),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

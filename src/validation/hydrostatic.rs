@@ -1,0 +1,517 @@
+//! A closed tank of water left to settle: compression, residual motion, water height against
+//! N·V/area, and the pressure profile against ρ0·g·(H − y) (ALGORITHM.md §10.1).
+//!
+//! Pressure. The density constraint has no pressure field, but its multiplier has the role of
+//! one. The force constraint i exerts on neighbour j at the converged iterate is
+//! f_ij = k·(P_ij − x_j) = k·λ_i·w_j·∇_{x_j}C_i = −k·λ_i·w_j·(m/ρ0)·∇W(x_i − x_j)
+//! (from M(x − s)/Δt² = k·Σ_i (P_i − x), the global step at its fixed point). The symmetric SPH
+//! pressure force particle i's pressure p_i exerts on j is m²·(p_i/ρ0²)·∇W(x_i − x_j). Equating
+//! the two gives p_i = −k·λ_i·w_j/V with V = m/ρ0; with w_j ≈ w_i = n_i + 1 this is the
+//! per-particle estimate p_i = −k·λ_i·(n_i + 1)/V used here, λ_i = −C_i/(|∇C_i|² + ε) being the
+//! local step's multiplier at the final positions. It is a reading of the constraint forces
+//! (their magnitude is set by the force balance, not by an equation of state), so it measures
+//! whether the constraints carry the weight of the water the way a pressure field would.
+
+use crate::boundary::Aabb;
+use crate::constraint::{Neighborhood, Projection};
+use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
+use crate::plot::{LineChart, Series, SeriesStyle};
+use crate::{Error, Params, SolverKind, Vec3, World};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// How the tank is set up and how long it settles.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setup {
+    /// Fluid lattice (x, y, z) in particles; y is up.
+    pub count: [usize; 3],
+    /// Particle radius r (m).
+    pub particle_radius: f64,
+    /// Settling time (s).
+    pub settle: f64,
+    /// Global solver.
+    pub solver: SolverKind,
+    /// Outer stopping threshold τ (m); `None` for the default 3e-3·r.
+    pub tolerance: Option<f64>,
+    /// Worker threads (0 = one per core).
+    pub threads: usize,
+}
+
+impl Default for Setup {
+    /// 12 × 16 × 12 particles of radius 0.025 m, settling for 2 s with the default solver.
+    fn default() -> Self {
+        Self {
+            count: [12, 16, 12],
+            particle_radius: crate::params::DEFAULT_PARTICLE_RADIUS,
+            settle: 2.0,
+            solver: SolverKind::Chebyshev,
+            tolerance: None,
+            threads: 0,
+        }
+    }
+}
+
+impl Setup {
+    /// Checks every field; the error names the bad one.
+    pub fn validate(&self) -> Result<(), Error> {
+        if self.count.iter().any(|&c| !(2..=100).contains(&c)) {
+            let c = format!("{:?}", self.count);
+            return Err(Error::invalid(
+                "count",
+                c,
+                "must lie between 2 and 100 per axis",
+            ));
+        }
+        if !(self.settle.is_finite() && self.settle > 0.0 && self.settle <= 60.0) {
+            return Err(Error::invalid(
+                "settle",
+                self.settle,
+                "must lie in (0, 60] seconds",
+            ));
+        }
+        Ok(())
+    }
+
+    /// The tank at t = 0: the block at rest density (mass factor 1) with its centres one
+    /// spacing plus r/4 from the walls, and a lid well above it.
+    pub fn build(&self) -> Result<(World, Aabb), Error> {
+        self.validate()?;
+        let defaults = Params::with_radius(self.particle_radius);
+        let params = Params {
+            mass_factor: 1.0,
+            solver: self.solver,
+            threads: self.threads,
+            displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),
+            ..defaults
+        };
+        let (r, d) = (params.particle_radius, params.spacing());
+        let mut world = World::new(params)?;
+        let gap = d + 0.25 * r;
+        let extent = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
+        let tank = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(
+                extent(self.count[0]),
+                1.5 * extent(self.count[1]),
+                extent(self.count[2]),
+            ),
+        };
+        world.add_container(tank, 1)?;
+        world.add_fluid_block(Vec3::repeat(gap), self.count, Vec3::zeros())?;
+        Ok((world, tank))
+    }
+}
+
+/// Mean estimated pressure of the particles in one horizontal layer of thickness d, over the
+/// steps of the last quarter second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layer {
+    /// Mean height of the layer's particles above the floor plane (m).
+    pub height: f64,
+    /// Mean pressure estimate of its particles (Pa).
+    pub pressure: f64,
+    /// ρ0·g·(H − y) at the layer's centre (Pa).
+    pub hydrostatic: f64,
+    /// Particle samples averaged (particles times steps).
+    pub particles: usize,
+}
+
+/// What the settled tank shows.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// What was run.
+    pub setup: Setup,
+    /// Fluid particles.
+    pub particles: usize,
+    /// Lattice spacing d (m).
+    pub spacing: f64,
+    /// Average compression of the last step (dimensionless).
+    pub density_error_avg: f64,
+    /// Largest compression of the last step (dimensionless).
+    pub density_error_max: f64,
+    /// Largest per-step average compression over the whole run (dimensionless).
+    pub density_error_avg_worst: f64,
+    /// RMS speed at the end (m/s).
+    pub rms_velocity: f64,
+    /// Water height H above the floor plane: the mean top-layer centre plus d/2, less the
+    /// d/2 between the floor plane and the water's bottom face (m).
+    pub height: f64,
+    /// N·V/area with V = m/ρ0 and the area the water covers, (L_x − d)(L_z − d) (m).
+    pub expected_height: f64,
+    /// Fluid particles outside the tank or non-finite.
+    pub escaped: usize,
+    /// (height above the floor plane (m), pressure estimate (Pa)) of every particle after the
+    /// last step.
+    pub pressures: Vec<(f64, f64)>,
+    /// Layer means over particles at least one support radius from the side walls, averaged
+    /// over the steps of the last quarter second.
+    pub profile: Vec<Layer>,
+    /// Least-squares slope −dp/dy of the layer means at least one support radius from the
+    /// surface and the floor, where particle pressures under-read (Pa/m); ρ0·g for a
+    /// hydrostatic column.
+    pub slope: f64,
+    /// ρ0·g (Pa/m).
+    pub hydrostatic_slope: f64,
+    /// Pearson correlation of the layer means with ρ0·g·(H − y) over the same layers: the
+    /// shape of the profile, whatever its scale (1 for a linear profile).
+    pub shape_correlation: f64,
+    /// Mean vertical constraint force per particle, Σ_i k·(P_ij − x_j), evaluated at the end of
+    /// each step of the last quarter second, over the particle weight m·g: 1 when the constraints are at the fixed point
+    /// that holds the water up, larger when the outer iteration stopped short of it.
+    pub force_balance: f64,
+}
+
+/// Lets the tank settle for `setup.settle` seconds and measures it; `progress` receives the
+/// fraction done after each step.
+pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
+    let (mut world, tank) = setup.build()?;
+    let mut worst: f64 = 0.0;
+    let end = setup.settle;
+    let d = world.params().spacing();
+    let h_support = world.params().support_radius();
+    let inner = |p: &Vec3| {
+        p.x - tank.min.x >= h_support
+            && tank.max.x - p.x >= h_support
+            && p.z - tank.min.z >= h_support
+            && tank.max.z - p.z >= h_support
+    };
+    // Layer sums (pressure, height, particles) over the last quarter second, or the last
+    // quarter of the run if shorter: one step's multipliers are noisy.
+    let window_start = end - (0.25_f64).min(0.25 * end);
+    let layers = ((tank.max.y - tank.min.y) / d).ceil() as usize + 1;
+    let mut sums = vec![(0.0, 0.0, 0usize); layers];
+    let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
+    let mut estimates = Vec::new();
+    while end - world.time() > 1e-12 * end {
+        let dt = world.next_dt().min(end - world.time());
+        let step = world.step_with_dt(dt)?;
+        worst = worst.max(step.density_error_avg);
+        if world.time() >= window_start {
+            let support;
+            (estimates, support) = constraint_pressures(&world);
+            for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
+                let y = p.y - tank.min.y;
+                let i = ((y / d).max(0.0) as usize).min(layers - 1);
+                sums[i].0 += v;
+                sums[i].1 += y;
+                sums[i].2 += 1;
+            }
+            support_sum += support;
+            sampled_steps += 1;
+        }
+        progress(world.time() / end);
+    }
+    let (density_error_avg, density_error_max) = world
+        .last_step()
+        .map_or((0.0, 0.0), |s| (s.density_error_avg, s.density_error_max));
+    let rho0 = world.params().rest_density;
+    let g = Vec3::from(world.params().gravity).norm();
+    let positions = world.positions();
+    let floor = tank.min.y;
+    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let surface: Vec<f64> = positions
+        .iter()
+        .map(|p| p.y)
+        .filter(|&y| y > top - 0.5 * d)
+        .collect();
+    let surface_y = surface.iter().sum::<f64>() / surface.len().max(1) as f64 + 0.5 * d;
+    let height = surface_y - (floor + 0.5 * d);
+    let volume = world.fluid_count() as f64 * world.particle_mass() / rho0;
+    let size = tank.max - tank.min;
+    let expected_height = volume / ((size.x - d) * (size.z - d));
+
+    let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
+    let support = support_sum / sampled_steps.max(1) as f64;
+    // The water's top face is the pressure datum: H above the floor plane is height + d/2.
+    let datum = height + 0.5 * d;
+    let profile: Vec<Layer> = sums
+        .iter()
+        .filter(|s| s.2 > 0)
+        .map(|s| {
+            let y = s.1 / s.2 as f64;
+            Layer {
+                height: y,
+                pressure: s.0 / s.2 as f64,
+                hydrostatic: rho0 * g * (datum - y),
+                particles: s.2,
+            }
+        })
+        .collect();
+    let fitted: Vec<(f64, f64)> = profile
+        .iter()
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
+        .map(|l| (l.height, l.pressure))
+        .collect();
+    let shape: Vec<(f64, f64)> = profile
+        .iter()
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
+        .map(|l| (l.pressure, l.hydrostatic))
+        .collect();
+    Ok(Report {
+        setup: setup.clone(),
+        particles: world.fluid_count(),
+        spacing: d,
+        density_error_avg,
+        density_error_max,
+        density_error_avg_worst: worst,
+        rms_velocity: world.rms_velocity(),
+        height,
+        expected_height,
+        escaped: world.escaped_count() + world.nan_count(),
+        pressures,
+        profile,
+        slope: -least_squares_slope(&fitted),
+        shape_correlation: correlation(&shape),
+        hydrostatic_slope: rho0 * g,
+        force_balance: support / (world.particle_mass() * g),
+    })
+}
+
+/// Pearson correlation of the pairs (NaN for fewer than two distinct values).
+fn correlation(pairs: &[(f64, f64)]) -> f64 {
+    let n = pairs.len() as f64;
+    let (ma, mb) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let cov: f64 = pairs.iter().map(|p| (p.0 - ma) * (p.1 - mb)).sum();
+    let va: f64 = pairs.iter().map(|p| (p.0 - ma).powi(2)).sum();
+    let vb: f64 = pairs.iter().map(|p| (p.1 - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
+/// Slope of the least-squares line through `points` (NaN for fewer than two x values).
+fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+/// The pressure estimate p_i = −k·λ_i·(n_i + 1)/V of every fluid particle at its current
+/// position (see the module docs), with that position, in storage order; and the mean
+/// vertical constraint force per particle (N).
+fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
+    let params = world.params();
+    let h = params.support_radius();
+    let fluid = &world.fluid.positions;
+    let boundary = &world.boundary;
+    let bounds = [fluid.as_slice(), &boundary.positions]
+        .iter()
+        .filter_map(|p| Aabb::around(p))
+        .reduce(|a, b| a.union(&b));
+    let Some(bounds) = bounds else {
+        return (Vec::new(), 0.0);
+    };
+    world.pool.install(|| {
+        let grid = UniformGrid::covering(bounds.min, bounds.max, h);
+        let sorted = |points: &[Vec3], table: &mut CellTable| {
+            let mut order = Vec::new();
+            grid.sort(points, &mut order, table);
+            order
+        };
+        let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
+        let fluid_order = sorted(fluid, &mut fluid_table);
+        let boundary_order = sorted(&boundary.positions, &mut boundary_table);
+        let x: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
+        let bx: Vec<Vec3> = boundary_order
+            .iter()
+            .map(|&i| boundary.positions[i as usize])
+            .collect();
+        let psi: Vec<f64> = boundary_order
+            .iter()
+            .map(|&i| boundary.psi[i as usize])
+            .collect();
+        let (mut fluid_lists, mut boundary_lists) =
+            (NeighborLists::default(), NeighborLists::default());
+        grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
+        grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
+        let mut stencil_offsets = Vec::new();
+        Neighborhood::stencil_offsets_of(&fluid_lists, &mut stencil_offsets);
+        let nb = Neighborhood {
+            fluid: &fluid_lists,
+            boundary: &boundary_lists,
+            boundary_positions: &bx,
+            boundary_psi: &psi,
+            stencil_offsets: &stencil_offsets,
+        };
+        let (mut projections, mut corrections) = (Vec::<Projection>::new(), Vec::new());
+        world
+            .constraint
+            .project(&x, &nb, &mut projections, &mut corrections);
+        let volume = world.constraint.mass / world.constraint.rest_density;
+        // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
+        // step gathers it.
+        let mut slots = Vec::new();
+        fluid_lists.reverse_slots(&mut slots);
+        for (slot, &i) in slots.iter_mut().zip(&fluid_lists.indices) {
+            *slot += i + 1;
+        }
+        let c = &world.constraint;
+        let force_sum: f64 = (0..x.len())
+            .map(|j| {
+                c.gathered_correction(j, &x, &nb, &projections, &corrections, &slots)
+                    .y
+            })
+            .sum();
+        let support = force_sum * params.stiffness / x.len().max(1) as f64;
+        let pressures = x
+            .iter()
+            .zip(&projections)
+            .enumerate()
+            .map(|(i, (p, proj))| {
+                let weight = (fluid_lists.count(i) + 1) as f64;
+                (*p, -params.stiffness * proj.lambda * weight / volume)
+            })
+            .collect();
+        (pressures, support)
+    })
+}
+
+impl Report {
+    /// A plain-text report of every measured quantity.
+    pub fn text(&self) -> String {
+        let mut out = String::new();
+        let s = &self.setup;
+        let _ = writeln!(
+            out,
+            "tank at rest: {} particles ({}x{}x{}, r = {} m), {} s settling, {} solver",
+            self.particles,
+            s.count[0],
+            s.count[1],
+            s.count[2],
+            s.particle_radius,
+            s.settle,
+            s.solver.name()
+        );
+        let rows = [
+            (
+                "density error (last step)",
+                format!(
+                    "avg {:.4} %, max {:.3} % (compression only)",
+                    100.0 * self.density_error_avg,
+                    100.0 * self.density_error_max
+                ),
+            ),
+            (
+                "density error (worst step avg)",
+                format!("{:.4} %", 100.0 * self.density_error_avg_worst),
+            ),
+            (
+                "rms velocity at the end",
+                format!("{:.4} m/s", self.rms_velocity),
+            ),
+            (
+                "water height",
+                format!(
+                    "{:.4} m, N·V/area gives {:.4} m ({:+.2} spacings)",
+                    self.height,
+                    self.expected_height,
+                    (self.height - self.expected_height) / self.spacing
+                ),
+            ),
+            (
+                "pressure slope -dp/dy",
+                format!(
+                    "{:.0} Pa/m, rho0·g = {:.0} Pa/m ({:+.1} %)",
+                    self.slope,
+                    self.hydrostatic_slope,
+                    100.0 * (self.slope / self.hydrostatic_slope - 1.0)
+                ),
+            ),
+            (
+                "pressure shape correlation",
+                format!(
+                    "{:.3} with rho0·g·(H - y) (1 = linear)",
+                    self.shape_correlation
+                ),
+            ),
+            (
+                "constraint force / weight",
+                format!("{:.3} (1 at the fixed point)", self.force_balance),
+            ),
+            ("escaped or NaN particles", self.escaped.to_string()),
+        ];
+        for (k, v) in rows {
+            let _ = writeln!(out, "{k:<32} {v}");
+        }
+        let _ = writeln!(
+            out,
+            "\npressure by layer (particles at least one support radius from the side walls)"
+        );
+        let _ = writeln!(
+            out,
+            "{:>8}  {:>10}  {:>16}  {:>6}",
+            "y (m)", "p (Pa)", "rho0 g (H-y) (Pa)", "count"
+        );
+        for l in &self.profile {
+            let _ = writeln!(
+                out,
+                "{:>8.3}  {:>10.1}  {:>16.1}  {:>6}",
+                l.height, l.pressure, l.hydrostatic, l.particles
+            );
+        }
+        out
+    }
+}
+
+/// The files [`write_report`] writes.
+#[derive(Clone, Debug)]
+pub struct ReportFiles {
+    /// Layer profile as CSV.
+    pub profile_csv: PathBuf,
+    /// Pressure chart.
+    pub pressure_png: PathBuf,
+}
+
+/// Writes the layer profile (CSV) and the pressure chart (PNG) into `dir` (which must exist).
+pub fn write_report(dir: &Path, report: &Report) -> Result<ReportFiles, Error> {
+    let files = ReportFiles {
+        profile_csv: dir.join("hydrostatic_profile.csv"),
+        pressure_png: dir.join("hydrostatic_pressure.png"),
+    };
+    let mut csv = String::from("height_m,pressure_pa,hydrostatic_pa,particles\n");
+    for l in &report.profile {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{}",
+            l.height, l.pressure, l.hydrostatic, l.particles
+        );
+    }
+    super::write_text(&files.profile_csv, &csv)?;
+    let series = vec![
+        Series {
+            label: "every particle".into(),
+            points: report.pressures.clone(),
+            style: SeriesStyle::Markers,
+        },
+        Series {
+            label: "layer mean, away from side walls".into(),
+            points: report
+                .profile
+                .iter()
+                .map(|l| (l.height, l.pressure))
+                .collect(),
+            style: SeriesStyle::LineMarkers,
+        },
+        Series {
+            label: "ρ0·g·(H − y)".into(),
+            points: report
+                .profile
+                .iter()
+                .map(|l| (l.height, l.hydrostatic))
+                .collect(),
+            style: SeriesStyle::Line,
+        },
+    ];
+    LineChart {
+        title: "Tank at rest: constraint pressure against hydrostatics".into(),
+        x_label: "height above the floor y (m)".into(),
+        y_label: "pressure (Pa)".into(),
+        series,
+    }
+    .write_png(&files.pressure_png)?;
+    Ok(files)
+}

@@ -3,14 +3,14 @@
 use crate::{Failure, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use projfluid::driver::{self, RunError, RunLength, StepReport};
 use projfluid::io::write_vtk;
 use projfluid::scene::Scene;
-use projfluid::stats::{RunAccumulator, RunSummary, StepStats};
+use projfluid::stats::RunSummary;
 use projfluid::{Error, SolverKind, World};
 use std::fs::File;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
 #[derive(Args)]
@@ -51,15 +51,6 @@ pub(crate) struct RunArgs {
     stats: Option<PathBuf>,
 }
 
-/// How long to run.
-#[derive(Clone, Copy)]
-enum Target {
-    /// Simulated seconds.
-    Time(f64),
-    /// Steps.
-    Steps(u64),
-}
-
 /// `projfluid run`.
 pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
     let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
@@ -85,8 +76,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         f.write(&world)?;
     }
     let goal = match target {
-        Target::Time(d) => format!("{d} s simulated"),
-        Target::Steps(n) => format!("{n} steps"),
+        RunLength::Duration(d) => format!("{d} s simulated"),
+        RunLength::Steps(n) => format!("{n} steps"),
     };
     eprintln!(
         "{}: {} particles, {} boundary particles, {} solver, {goal}",
@@ -95,39 +86,20 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         world.boundary_count(),
         scene.params.solver.name()
     );
-    let mut acc = RunAccumulator::default();
     let mut progress = Progress::new(target);
-    let (start, end) = (world.time(), world.time() + scene.duration);
-    loop {
-        let dt = match target {
-            Target::Time(_) => {
-                let left = end - world.time();
-                if left <= 1e-12 * end.abs().max(1.0) {
-                    break;
-                }
-                world.next_dt().min(left)
-            }
-            Target::Steps(n) if acc.steps() >= n => break,
-            Target::Steps(_) => world.next_dt(),
-        };
-        let clock = Instant::now();
-        let stats = world
-            .step_with_dt(dt)
-            .map_err(|e| Failure::Runtime(format!("step {} failed: {e}", acc.steps() + 1)))?
-            .clone();
-        let wall = clock.elapsed().as_secs_f64();
-        acc.add(&stats, wall);
+    let acc = driver::run(&mut world, target, |report| {
         if let Some(f) = frames.as_mut() {
-            if acc.steps() % f.every as u64 == 0 {
-                f.write(&world)?;
+            if report.steps % f.every as u64 == 0 {
+                f.write(report.world)?;
             }
         }
-        let done = match target {
-            Target::Time(d) => (world.time() - start) / d,
-            Target::Steps(n) => acc.steps() as f64 / n as f64,
-        };
-        progress.update(done, &world, &stats, wall);
-    }
+        progress.update(report);
+        Ok(())
+    })
+    .map_err(|e| match e {
+        RunError::Step { step, error } => Failure::Runtime(format!("step {step} failed: {error}")),
+        RunError::Callback(failure) => failure,
+    })?;
     progress.finish();
     let summary = acc.summary(&scene.name, &world);
     print_summary(&summary)
@@ -149,7 +121,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
 }
 
 /// Applies the command-line overrides to `scene` and checks the result; errors name the option.
-fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure> {
+fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failure> {
     let p = &mut scene.params;
     if let Some(s) = args.solver {
         p.solver = s;
@@ -197,8 +169,8 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure>
         Failure::Input(msg)
     })?;
     Ok(match args.steps {
-        Some(n) => Target::Steps(n),
-        None => Target::Time(scene.duration),
+        Some(n) => RunLength::Steps(n),
+        None => RunLength::Duration(scene.duration),
     })
 }
 
@@ -250,7 +222,7 @@ struct Progress {
 }
 
 impl Progress {
-    fn new(target: Target) -> Self {
+    fn new(target: RunLength) -> Self {
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             let style = ProgressStyle::with_template(
@@ -258,7 +230,7 @@ impl Progress {
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar());
             bar.set_style(style);
-            if let Target::Steps(n) = target {
+            if let RunLength::Steps(n) = target {
                 bar.set_message(format!("0/{n} steps"));
             }
             bar
@@ -272,14 +244,18 @@ impl Progress {
         }
     }
 
-    /// Records a step that took `wall` seconds; `done` is the finished fraction of the run.
-    fn update(&mut self, done: f64, world: &World, step: &StepStats, wall: f64) {
+    /// Records a finished step.
+    fn update(&mut self, report: &StepReport<'_>) {
         self.steps += 1;
-        self.wall += wall;
-        self.outer += step.outer_iterations as u64;
+        self.wall += report.wall_seconds;
+        self.outer += report.stats.outer_iterations as u64;
         let n = self.steps as f64;
-        let (t, ms, outer) = (world.time(), self.wall * 1e3 / n, self.outer as f64 / n);
-        let done = done.clamp(0.0, 1.0);
+        let (t, ms, outer) = (
+            report.world.time(),
+            self.wall * 1e3 / n,
+            self.outer as f64 / n,
+        );
+        let done = report.done;
         match &self.bar {
             Some(bar) => {
                 bar.set_position((done * 1000.0).round() as u64);

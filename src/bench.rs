@@ -1,0 +1,274 @@
+//! The solver benchmark of the paper's Table 1: every scene with every global solver, the same
+//! parameters and stopping rule, the first N steps; a table of cost, accuracy and an
+//! "artifacts" verdict, written as Markdown and CSV.
+
+use crate::driver::{self, RunLength};
+use crate::scene::Scene;
+use crate::stats::RunSummary;
+use crate::{Error, SolverKind};
+use std::fmt;
+
+/// The paper's protocol: the mean over the first 80 time steps.
+pub const DEFAULT_STEPS: u64 = 80;
+
+/// A run "has artifacts" when its mean density error exceeds this (percent; ALGORITHM.md §10.1
+/// asks for ≲ 0.1 %).
+pub const AVG_DENSITY_ERROR_LIMIT_PERCENT: f64 = 0.1;
+/// … or its largest density error exceeds this (percent; the upper end of the ≲ 1–3 % of
+/// ALGORITHM.md §10.1).
+pub const MAX_DENSITY_ERROR_LIMIT_PERCENT: f64 = 3.0;
+/// … or its total energy ever rose above the initial value by more than this fraction of it
+/// (implicit Euler and XSPH only dissipate, so a converged run never rises at all).
+pub const ENERGY_RISE_LIMIT: f64 = 0.01;
+
+/// One reason a run counts as having artifacts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Artifact {
+    /// This many particles had a non-finite position or velocity.
+    NotFinite(usize),
+    /// This many particles left the container.
+    Escaped(usize),
+    /// Mean density error (percent) above [`AVG_DENSITY_ERROR_LIMIT_PERCENT`].
+    AverageDensityError(f64),
+    /// Largest density error (percent) above [`MAX_DENSITY_ERROR_LIMIT_PERCENT`].
+    MaxDensityError(f64),
+    /// Total energy rose above its initial value by this fraction (above [`ENERGY_RISE_LIMIT`]).
+    EnergyRise(f64),
+}
+
+impl fmt::Display for Artifact {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Artifact::NotFinite(n) => write!(f, "{n} NaN"),
+            Artifact::Escaped(n) => write!(f, "{n} escaped"),
+            Artifact::AverageDensityError(p) => write!(f, "avg density error {p:.3} %"),
+            Artifact::MaxDensityError(p) => write!(f, "max density error {p:.2} %"),
+            Artifact::EnergyRise(x) => write!(f, "energy +{:.2} %", x * 100.0),
+        }
+    }
+}
+
+/// The artifacts rule: every limit a run broke (empty when none). A non-finite statistic
+/// counts as broken.
+pub fn artifacts(s: &RunSummary) -> Vec<Artifact> {
+    let mut found = Vec::new();
+    if s.nan > 0 {
+        found.push(Artifact::NotFinite(s.nan));
+    }
+    if s.escaped > 0 {
+        found.push(Artifact::Escaped(s.escaped));
+    }
+    if above(s.density_error_avg_percent, AVG_DENSITY_ERROR_LIMIT_PERCENT) {
+        found.push(Artifact::AverageDensityError(s.density_error_avg_percent));
+    }
+    if above(s.density_error_max_percent, MAX_DENSITY_ERROR_LIMIT_PERCENT) {
+        found.push(Artifact::MaxDensityError(s.density_error_max_percent));
+    }
+    if let Some(rise) = s.energy_rise() {
+        if above(rise, ENERGY_RISE_LIMIT) {
+            found.push(Artifact::EnergyRise(rise));
+        }
+    }
+    found
+}
+
+/// `value` exceeds `limit`, or is NaN (a broken statistic never passes a limit).
+pub(crate) fn above(value: f64, limit: f64) -> bool {
+    value.is_nan() || value > limit
+}
+
+/// One scene run with one solver.
+#[derive(Clone, Debug, PartialEq)]
+pub struct BenchRow {
+    /// The run's statistics.
+    pub summary: RunSummary,
+    /// What the artifacts rule found.
+    pub artifacts: Vec<Artifact>,
+}
+
+impl BenchRow {
+    /// The verdict as one cell: `none`, or the broken limits joined by `; `.
+    pub fn verdict(&self) -> String {
+        if self.artifacts.is_empty() {
+            return "none".to_string();
+        }
+        let parts: Vec<String> = self.artifacts.iter().map(|a| a.to_string()).collect();
+        parts.join("; ")
+    }
+
+    /// Relative energy rise in percent (0 when the energy never rose; NaN when undefined).
+    fn energy_rise_percent(&self) -> f64 {
+        self.summary.energy_rise().map_or(f64::NAN, |x| x * 100.0)
+    }
+}
+
+/// What [`run_bench`] is doing, for progress messages.
+#[derive(Clone, Copy, Debug)]
+pub enum BenchEvent<'a> {
+    /// A run of `scene` with `solver` starts.
+    Start {
+        /// Scene name.
+        scene: &'a str,
+        /// Solver.
+        solver: SolverKind,
+    },
+    /// A run finished.
+    Done(&'a BenchRow),
+}
+
+/// Runs every scene with every solver for `steps` steps, each from the scene's initial state
+/// with the scene's parameters except the solver, and returns one row per run, scenes outer,
+/// solvers inner, in the given orders.
+pub fn run_bench(
+    scenes: &[Scene],
+    solvers: &[SolverKind],
+    steps: u64,
+    mut on_event: impl FnMut(BenchEvent<'_>),
+) -> Result<Vec<BenchRow>, Error> {
+    let mut rows = Vec::with_capacity(scenes.len() * solvers.len());
+    for scene in scenes {
+        for &solver in solvers {
+            on_event(BenchEvent::Start {
+                scene: &scene.name,
+                solver,
+            });
+            let mut scene = scene.clone();
+            scene.params.solver = solver;
+            let mut world = scene.build_world()?;
+            let acc = driver::run_quietly(&mut world, RunLength::Steps(steps))?;
+            let summary = acc.summary(&scene.name, &world);
+            let row = BenchRow {
+                artifacts: artifacts(&summary),
+                summary,
+            };
+            on_event(BenchEvent::Done(&row));
+            rows.push(row);
+        }
+    }
+    Ok(rows)
+}
+
+/// The columns of [`markdown`] and [`csv`]: header and the cell of a row.
+type Column = (&'static str, &'static str, fn(&BenchRow) -> String);
+
+/// (Markdown header, CSV header, cell).
+const COLUMNS: [Column; 13] = [
+    ("scene", "scene", |r| r.summary.scene.clone()),
+    ("solver", "solver", |r| r.summary.solver.clone()),
+    ("particles", "particles", |r| {
+        r.summary.particles.to_string()
+    }),
+    ("threads", "threads", |r| r.summary.threads.to_string()),
+    ("steps", "steps", |r| r.summary.steps.to_string()),
+    ("ms / step", "ms_per_step", |r| {
+        format!("{:.2}", r.summary.wall_ms_per_step)
+    }),
+    ("outer it. / step", "outer_iterations_mean", |r| {
+        format!("{:.2}", r.summary.outer_iterations_mean)
+    }),
+    ("inner it. / step", "inner_iterations_mean", |r| {
+        format!("{:.2}", r.summary.inner_iterations_mean)
+    }),
+    ("K_max hits", "max_iteration_hits", |r| {
+        r.summary.max_iteration_hits.to_string()
+    }),
+    ("avg density error %", "density_error_avg_percent", |r| {
+        format!("{:.4}", r.summary.density_error_avg_percent)
+    }),
+    ("max density error %", "density_error_max_percent", |r| {
+        format!("{:.3}", r.summary.density_error_max_percent)
+    }),
+    ("energy rise %", "energy_rise_percent", |r| {
+        format!("{:.3}", r.energy_rise_percent())
+    }),
+    ("artifacts", "artifacts", BenchRow::verdict),
+];
+
+/// The table as GitHub Markdown, one row per run.
+pub fn markdown(rows: &[BenchRow]) -> String {
+    let mut out = String::new();
+    let line = |cells: Vec<String>| format!("| {} |\n", cells.join(" | "));
+    out += &line(COLUMNS.iter().map(|c| c.0.to_string()).collect());
+    out += &line(COLUMNS.iter().map(|_| "---".to_string()).collect());
+    for row in rows {
+        out += &line(COLUMNS.iter().map(|c| (c.2)(row)).collect());
+    }
+    out
+}
+
+/// The table as CSV (comma-separated, header line first, no quoting needed: no cell holds a
+/// comma or a quote).
+pub fn csv(rows: &[BenchRow]) -> String {
+    let mut out = COLUMNS.map(|c| c.1).join(",") + "\n";
+    for row in rows {
+        let cells: Vec<String> = COLUMNS
+            .iter()
+            .map(|c| (c.2)(row).replace([',', '"'], " "))
+            .collect();
+        out += &(cells.join(",") + "\n");
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn clean() -> RunSummary {
+        RunSummary {
+            scene: "s".into(),
+            solver: "jacobi1".into(),
+            density_error_avg_percent: 0.01,
+            density_error_max_percent: 0.2,
+            energy_initial: 100.0,
+            energy_max: 100.0,
+            energy_final: 90.0,
+            ..RunSummary::default()
+        }
+    }
+
+    #[test]
+    fn artifacts_rule_flags_each_broken_limit() {
+        assert!(artifacts(&clean()).is_empty());
+        let broken = RunSummary {
+            nan: 2,
+            escaped: 3,
+            density_error_avg_percent: 0.2,
+            density_error_max_percent: f64::NAN,
+            energy_max: 101.5,
+            ..clean()
+        };
+        let found = artifacts(&broken);
+        assert_eq!(found.len(), 5, "{found:?}");
+        assert_eq!(found[4], Artifact::EnergyRise(0.015));
+        let row = BenchRow {
+            summary: broken,
+            artifacts: found,
+        };
+        assert!(
+            row.verdict()
+                .starts_with("2 NaN; 3 escaped; avg density error 0.200 %")
+        );
+    }
+
+    #[test]
+    fn tables_have_one_line_per_row_and_matching_columns() {
+        let rows = vec![
+            BenchRow {
+                summary: clean(),
+                artifacts: vec![],
+            };
+            2
+        ];
+        let md = markdown(&rows);
+        assert_eq!(md.lines().count(), 4);
+        assert!(
+            md.lines()
+                .all(|l| l.matches('|').count() == COLUMNS.len() + 1)
+        );
+        let csv = csv(&rows);
+        assert_eq!(csv.lines().count(), 3);
+        assert!(csv.lines().all(|l| l.split(',').count() == COLUMNS.len()));
+        assert!(csv.lines().nth(1).unwrap().ends_with(",0.000,none"));
+    }
+}

@@ -5,6 +5,7 @@
 use crate::driver::{self, RunLength};
 use crate::scene::Scene;
 use crate::stats::RunSummary;
+use crate::table::{self, Cell, Column};
 use crate::{Error, SolverKind};
 use std::fmt;
 
@@ -148,66 +149,83 @@ pub fn run_bench(
     Ok(rows)
 }
 
-/// The columns of [`markdown`] and [`csv`]: header and the cell of a row.
-type Column = (&'static str, &'static str, fn(&BenchRow) -> String);
-
-/// (Markdown header, CSV header, cell).
-const COLUMNS: [Column; 13] = [
-    ("scene", "scene", |r| r.summary.scene.clone()),
-    ("solver", "solver", |r| r.summary.solver.clone()),
-    ("particles", "particles", |r| {
-        r.summary.particles.to_string()
-    }),
-    ("threads", "threads", |r| r.summary.threads.to_string()),
-    ("steps", "steps", |r| r.summary.steps.to_string()),
-    ("ms / step", "ms_per_step", |r| {
-        format!("{:.2}", r.summary.wall_ms_per_step)
-    }),
-    ("outer it. / step", "outer_iterations_mean", |r| {
-        format!("{:.2}", r.summary.outer_iterations_mean)
-    }),
-    ("inner it. / step", "inner_iterations_mean", |r| {
-        format!("{:.2}", r.summary.inner_iterations_mean)
-    }),
-    ("K_max hits", "max_iteration_hits", |r| {
-        r.summary.max_iteration_hits.to_string()
-    }),
-    ("avg density error %", "density_error_avg_percent", |r| {
-        format!("{:.4}", r.summary.density_error_avg_percent)
-    }),
-    ("max density error %", "density_error_max_percent", |r| {
-        format!("{:.3}", r.summary.density_error_max_percent)
-    }),
-    ("energy rise %", "energy_rise_percent", |r| {
-        format!("{:.3}", r.energy_rise_percent())
-    }),
-    ("artifacts", "artifacts", BenchRow::verdict),
+/// The columns of [`markdown`] and [`csv`].
+const COLUMNS: [Column<BenchRow>; 13] = [
+    Column {
+        title: "scene",
+        key: "scene",
+        cell: |r| Cell::Text(r.summary.scene.clone()),
+    },
+    Column {
+        title: "solver",
+        key: "solver",
+        cell: |r| Cell::Text(r.summary.solver.clone()),
+    },
+    Column {
+        title: "particles",
+        key: "particles",
+        cell: |r| Cell::Number(r.summary.particles as f64, 0),
+    },
+    Column {
+        title: "threads",
+        key: "threads",
+        cell: |r| Cell::Number(r.summary.threads as f64, 0),
+    },
+    Column {
+        title: "steps",
+        key: "steps",
+        cell: |r| Cell::Number(r.summary.steps as f64, 0),
+    },
+    Column {
+        title: "ms / step",
+        key: "ms_per_step",
+        cell: |r| Cell::Number(r.summary.wall_ms_per_step, 1),
+    },
+    Column {
+        title: "outer it. / step",
+        key: "outer_iterations_mean",
+        cell: |r| Cell::Number(r.summary.outer_iterations_mean, 2),
+    },
+    Column {
+        title: "inner it. / step",
+        key: "inner_iterations_mean",
+        cell: |r| Cell::Number(r.summary.inner_iterations_mean, 2),
+    },
+    Column {
+        title: "K_max hits",
+        key: "max_iteration_hits",
+        cell: |r| Cell::Number(r.summary.max_iteration_hits as f64, 0),
+    },
+    Column {
+        title: "avg density error %",
+        key: "density_error_avg_percent",
+        cell: |r| Cell::Number(r.summary.density_error_avg_percent, 4),
+    },
+    Column {
+        title: "max density error %",
+        key: "density_error_max_percent",
+        cell: |r| Cell::Number(r.summary.density_error_max_percent, 3),
+    },
+    Column {
+        title: "energy rise %",
+        key: "energy_rise_percent",
+        cell: |r| Cell::Number(r.energy_rise_percent(), 2),
+    },
+    Column {
+        title: "artifacts",
+        key: "artifacts",
+        cell: |r| Cell::Text(r.verdict()),
+    },
 ];
 
 /// The table as GitHub Markdown, one row per run.
 pub fn markdown(rows: &[BenchRow]) -> String {
-    let mut out = String::new();
-    let line = |cells: Vec<String>| format!("| {} |\n", cells.join(" | "));
-    out += &line(COLUMNS.iter().map(|c| c.0.to_string()).collect());
-    out += &line(COLUMNS.iter().map(|_| "---".to_string()).collect());
-    for row in rows {
-        out += &line(COLUMNS.iter().map(|c| (c.2)(row)).collect());
-    }
-    out
+    table::markdown(&COLUMNS, rows)
 }
 
-/// The table as CSV (comma-separated, header line first, no quoting needed: no cell holds a
-/// comma or a quote).
+/// The table as CSV (header line of keys, numbers in full precision).
 pub fn csv(rows: &[BenchRow]) -> String {
-    let mut out = COLUMNS.map(|c| c.1).join(",") + "\n";
-    for row in rows {
-        let cells: Vec<String> = COLUMNS
-            .iter()
-            .map(|c| (c.2)(row).replace([',', '"'], " "))
-            .collect();
-        out += &(cells.join(",") + "\n");
-    }
-    out
+    table::csv(&COLUMNS, rows)
 }
 
 #[cfg(test)]
@@ -269,6 +287,6 @@ mod tests {
         let csv = csv(&rows);
         assert_eq!(csv.lines().count(), 3);
         assert!(csv.lines().all(|l| l.split(',').count() == COLUMNS.len()));
-        assert!(csv.lines().nth(1).unwrap().ends_with(",0.000,none"));
+        assert!(csv.lines().nth(1).unwrap().ends_with(",0,none"));
     }
 }

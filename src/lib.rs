@@ -30,6 +30,7 @@ pub mod scene;
 pub mod solver;
 pub mod stats;
 mod step;
+mod table;
 pub mod tuning;
 mod world;
 

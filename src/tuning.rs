@@ -6,6 +6,10 @@
 //! The estimators ([`fit_contraction`], [`contraction_estimate`], [`median`]) work on any δ_k
 //! sequence, e.g. [`crate::World::last_displacements`], so an online choice of ρ can use them too.
 
+mod table;
+
+pub use table::{csv, markdown};
+
 use crate::bench::above;
 use crate::driver::{self, RunLength};
 use crate::scene::Scene;

@@ -4,12 +4,18 @@
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
 //! projfluid scenes
+//! projfluid bench [--scenes A,B,…] [--solvers A,B,…] [--steps N] [--rho R] [--tau METRES]
+//!                 [--threads N] [--out DIR]
+//! projfluid tune-rho SCENE [--steps T] [--warmup N] [--from R] [--to R] [--step R]
+//!                    [--tau METRES] [--threads N] [--out DIR]
 //! ```
 //!
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
 //! Each subcommand lives in its own module.
 
+mod bench;
 mod run;
+mod tune_rho;
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
 use clap::{Parser, Subcommand};
@@ -37,6 +43,10 @@ enum Command {
     Run(run::RunArgs),
     /// List the built-in scenes.
     Scenes,
+    /// Run scenes with several solvers and tabulate cost, accuracy and artifacts.
+    Bench(bench::BenchArgs),
+    /// Choose Chebyshev's ρ for a scene: estimate it, then sweep it.
+    TuneRho(tune_rho::TuneRhoArgs),
 }
 
 /// Why the program stops early; decides the exit code.
@@ -59,6 +69,8 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::Run(args) => run::run(&args),
         Command::Scenes => list_scenes(),
+        Command::Bench(args) => bench::bench(&args),
+        Command::TuneRho(args) => tune_rho::tune_rho(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -31,15 +31,8 @@ pub(crate) struct RunArgs {
     /// Global solver (the README's "Command line" section describes each).
     #[arg(long, value_parser = solver_parser())]
     solver: Option<SolverKind>,
-    /// Chebyshev spectral radius estimate ρ_c, in [0, 1).
-    #[arg(long, value_name = "R", allow_negative_numbers = true)]
-    rho: Option<f64>,
-    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
-    tau: Option<f64>,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    params: ParamOptions,
     /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -49,6 +42,69 @@ pub(crate) struct RunArgs {
     /// Write the run summary as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats: Option<PathBuf>,
+}
+
+/// Solver settings that every subcommand running scenes accepts; each given option replaces
+/// the scene's setting.
+#[derive(Args)]
+pub(crate) struct ParamOptions {
+    /// Chebyshev spectral radius estimate ρ_c, in [0, 1).
+    #[arg(long, value_name = "R", allow_negative_numbers = true)]
+    pub(crate) rho: Option<f64>,
+    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub(crate) tau: Option<f64>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N")]
+    pub(crate) threads: Option<usize>,
+}
+
+impl ParamOptions {
+    /// Sets the given options in `scene.params`.
+    fn apply(&self, scene: &mut Scene) {
+        let p = &mut scene.params;
+        if let Some(rho) = self.rho {
+            p.chebyshev.rho = rho;
+        }
+        if let Some(tau) = self.tau {
+            p.displacement_tolerance = tau;
+        }
+        if let Some(threads) = self.threads {
+            p.threads = threads;
+        }
+    }
+
+    /// Which scene key each option sets, and whether it was given.
+    fn keys(&self) -> [(&'static str, &'static str, bool); 3] {
+        [
+            ("solver.rho", "--rho", self.rho.is_some()),
+            ("solver.tau", "--tau", self.tau.is_some()),
+            ("threads", "--threads", self.threads.is_some()),
+        ]
+    }
+
+    /// Applies the options to `scene` and validates it; an error caused by an option names
+    /// the option instead of the scene key.
+    pub(crate) fn apply_checked(&self, scene: &mut Scene) -> Result<(), Failure> {
+        self.apply(scene);
+        validate_naming_options(scene, &self.keys())
+    }
+}
+
+/// Validates `scene`; when the error is about a scene key set by a given option (key, option,
+/// given), the message names the option.
+fn validate_naming_options(scene: &Scene, options: &[(&str, &str, bool)]) -> Result<(), Failure> {
+    scene.validate().map_err(|e| {
+        let msg = e.to_string();
+        if let Error::InvalidArgument { field, .. } = &e {
+            for &(key, option, given) in options {
+                if given && field == key {
+                    return Failure::Input(msg.replacen(key, option, 1));
+                }
+            }
+        }
+        Failure::Input(msg)
+    })
 }
 
 /// `projfluid run`.
@@ -122,19 +178,10 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
 
 /// Applies the command-line overrides to `scene` and checks the result; errors name the option.
 fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failure> {
-    let p = &mut scene.params;
     if let Some(s) = args.solver {
-        p.solver = s;
+        scene.params.solver = s;
     }
-    if let Some(rho) = args.rho {
-        p.chebyshev.rho = rho;
-    }
-    if let Some(tau) = args.tau {
-        p.displacement_tolerance = tau;
-    }
-    if let Some(threads) = args.threads {
-        p.threads = threads;
-    }
+    args.params.apply(scene);
     if let Some(every) = args.every {
         scene.output.every = every;
     }
@@ -149,25 +196,12 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
             Error::invalid("--steps", 0, "must be at least 1").to_string(),
         ));
     }
-    // Which scene key each option sets, to name the option in errors.
-    let options = [
-        ("solver.rho", "--rho", args.rho.is_some()),
-        ("solver.tau", "--tau", args.tau.is_some()),
-        ("threads", "--threads", args.threads.is_some()),
+    let mut options = args.params.keys().to_vec();
+    options.extend([
         ("output.every", "--every", args.every.is_some()),
         ("duration", "--duration", args.duration.is_some()),
-    ];
-    scene.validate().map_err(|e| {
-        let msg = e.to_string();
-        if let Error::InvalidArgument { field, .. } = &e {
-            for (key, option, given) in options {
-                if given && field == key {
-                    return Failure::Input(msg.replacen(key, option, 1));
-                }
-            }
-        }
-        Failure::Input(msg)
-    })?;
+    ]);
+    validate_naming_options(scene, &options)?;
     Ok(match args.steps {
         Some(n) => RunLength::Steps(n),
         None => RunLength::Duration(scene.duration),

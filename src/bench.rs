@@ -150,7 +150,7 @@ pub fn run_bench(
 }
 
 /// The columns of [`markdown`] and [`csv`].
-const COLUMNS: [Column<BenchRow>; 13] = [
+const COLUMNS: [Column<BenchRow>; 14] = [
     Column {
         title: "scene",
         key: "scene",
@@ -180,6 +180,11 @@ const COLUMNS: [Column<BenchRow>; 13] = [
         title: "ms / step",
         key: "ms_per_step",
         cell: |r| Cell::Number(r.summary.wall_ms_per_step, 1),
+    },
+    Column {
+        title: "CPU ms / step",
+        key: "cpu_ms_per_step",
+        cell: |r| Cell::Number(r.summary.cpu_ms_per_step.unwrap_or(f64::NAN), 1),
     },
     Column {
         title: "outer it. / step",

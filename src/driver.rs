@@ -24,6 +24,8 @@ pub struct StepReport<'a> {
     pub stats: &'a StepStats,
     /// Wall-clock time of the step alone (s).
     pub wall_seconds: f64,
+    /// Processor time of the step alone, all threads of the process (s), where available.
+    pub cpu_seconds: Option<f64>,
     /// Steps taken in this run so far, this one included.
     pub steps: u64,
     /// Finished fraction of the run, in [0, 1].
@@ -102,7 +104,7 @@ pub fn run<E>(
                 world.next_dt().min(left)
             }
         };
-        let clock = Instant::now();
+        let (clock, cpu) = (Instant::now(), process_cpu_seconds());
         let stats = match world.step_with_dt(dt) {
             Ok(stats) => stats.clone(),
             Err(error) => {
@@ -111,7 +113,11 @@ pub fn run<E>(
             }
         };
         let wall_seconds = clock.elapsed().as_secs_f64();
+        let cpu_seconds = cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a);
         acc.add(&stats, wall_seconds);
+        if let Some(cpu) = cpu_seconds {
+            acc.add_cpu_time(cpu);
+        }
         acc.record_energy(total_energy(world, datum));
         let done = match length {
             RunLength::Steps(n) => acc.steps() as f64 / n as f64,
@@ -122,12 +128,31 @@ pub fn run<E>(
             world,
             stats: &stats,
             wall_seconds,
+            cpu_seconds,
             steps: acc.steps(),
             done: done.clamp(0.0, 1.0),
         };
         on_step(&report).map_err(RunError::Callback)?;
     }
     Ok(acc)
+}
+
+/// Processor time (s) used so far by all threads of this process, user plus system.
+#[cfg(unix)]
+fn process_cpu_seconds() -> Option<f64> {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+        return None;
+    }
+    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    Some(seconds(usage.ru_utime) + seconds(usage.ru_stime))
+}
+
+/// Not reported on this platform.
+#[cfg(not(unix))]
+fn process_cpu_seconds() -> Option<f64> {
+    None
 }
 
 /// [`run`] without a per-step callback.
@@ -188,6 +213,9 @@ mod tests {
         assert_eq!(seen[2].1, 1.0);
         assert!(seen.iter().all(|s| s.2 >= 1));
         let summary = acc.summary("s", &world);
+        if cfg!(unix) {
+            assert!(summary.cpu_ms_per_step.unwrap() > 0.0);
+        }
         // At rest above its lowest particle the block has positive potential energy; the
         // dissipative step never adds energy in the first steps of the collapse.
         assert!(summary.energy_initial > 0.0);

@@ -60,6 +60,10 @@ pub struct RunSummary {
     pub sim_time: f64,
     /// Mean wall-clock time per step (ms).
     pub wall_ms_per_step: f64,
+    /// Mean processor time per step, summed over all threads of the process (ms); less
+    /// sensitive than wall time to other programs on a shared machine. `None` where the
+    /// platform does not report it.
+    pub cpu_ms_per_step: Option<f64>,
     /// Mean outer iterations per step.
     pub outer_iterations_mean: f64,
     /// Mean inner (linear-solver) iterations per step: Jacobi sweeps or CG iterations summed
@@ -103,6 +107,7 @@ pub struct RunAccumulator {
     steps: u64,
     sim_time: f64,
     wall_seconds: f64,
+    cpu_seconds: Option<f64>,
     outer: u64,
     inner: u64,
     max_iteration_hits: u64,
@@ -131,6 +136,11 @@ impl RunAccumulator {
         {
             *acc += v;
         }
+    }
+
+    /// Adds the processor time (s, all threads) of the steps added since the last call.
+    pub fn add_cpu_time(&mut self, seconds: f64) {
+        *self.cpu_seconds.get_or_insert(0.0) += seconds;
     }
 
     /// Records the total energy (J) at the start of the run (first call) or after a step.
@@ -167,6 +177,7 @@ impl RunAccumulator {
             steps: self.steps,
             sim_time: self.sim_time,
             wall_ms_per_step: self.wall_seconds * 1e3 / n,
+            cpu_ms_per_step: self.cpu_seconds.map(|s| s * 1e3 / n),
             outer_iterations_mean: self.outer as f64 / n,
             inner_iterations_mean: self.inner as f64 / n,
             max_iteration_hits: self.max_iteration_hits,

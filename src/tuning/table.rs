@@ -44,7 +44,7 @@ fn energy_vs_plain(run: &RunSummary, plain: &RunSummary) -> f64 {
 }
 
 /// The table's columns.
-fn columns<'a>() -> [Column<Row<'a>>; 7] {
+fn columns<'a>() -> [Column<Row<'a>>; 8] {
     [
         Column {
             title: "ρ",
@@ -55,6 +55,11 @@ fn columns<'a>() -> [Column<Row<'a>>; 7] {
             title: "ms / step",
             key: "ms_per_step",
             cell: |r| Cell::Number(r.run.wall_ms_per_step, 1),
+        },
+        Column {
+            title: "CPU ms / step",
+            key: "cpu_ms_per_step",
+            cell: |r| Cell::Number(r.run.cpu_ms_per_step.unwrap_or(f64::NAN), 1),
         },
         Column {
             title: "outer it. / step",

@@ -54,12 +54,7 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
         args.solvers.clone()
     };
     // Create the output directory first, so that an unwritable path fails before the runs.
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        Failure::Runtime(format!(
-            "cannot create output directory {}: {e}",
-            args.out.display()
-        ))
-    })?;
+    create_dir(&args.out)?;
     let rows = bench::run_bench(&scenes, &solvers, args.steps, |event| match event {
         BenchEvent::Start { scene, solver } => {
             eprintln!("{scene} {}: {} steps…", solver.name(), args.steps)
@@ -73,13 +68,28 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
     })
     .map_err(|e| Failure::Runtime(e.to_string()))?;
     let table = bench::markdown(&rows);
-    let mut out = std::io::stdout().lock();
-    out.write_all(table.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))?;
+    print(&table)?;
     write_file(&args.out.join("bench.md"), &table)?;
     write_file(&args.out.join("bench.csv"), &bench::csv(&rows))?;
     write_chart(&args.out, &rows)
+}
+
+/// Creates the output directory `dir` (and its parents) if missing.
+pub(crate) fn create_dir(dir: &Path) -> Result<(), Failure> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Failure::Runtime(format!(
+            "cannot create output directory {}: {e}",
+            dir.display()
+        ))
+    })
+}
+
+/// Writes `text` to stdout.
+pub(crate) fn print(text: &str) -> Result<(), Failure> {
+    let mut out = std::io::stdout().lock();
+    out.write_all(text.as_bytes())
+        .and_then(|()| out.flush())
+        .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))
 }
 
 /// Writes `text` to `path`.

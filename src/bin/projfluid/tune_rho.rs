@@ -1,13 +1,12 @@
 //! `projfluid tune-rho`: estimates Chebyshev's ρ for a scene and sweeps it (ALGORITHM.md §5.2).
 
 use crate::Failure;
-use crate::bench::write_file;
+use crate::bench::{create_dir, print, write_file};
 use crate::run::ParamOptions;
 use clap::Args;
 use projfluid::scene::Scene;
 use projfluid::tuning::{self, Phase, TuneConfig, TuneReport};
 use projfluid::{Error, SolverKind};
-use std::io::Write;
 use std::path::{Path, PathBuf};
 
 /// Options of `projfluid tune-rho`.
@@ -77,12 +76,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         grid,
         ..TuneConfig::default()
     };
-    std::fs::create_dir_all(&args.out).map_err(|e| {
-        Failure::Runtime(format!(
-            "cannot create output directory {}: {e}",
-            args.out.display()
-        ))
-    })?;
+    create_dir(&args.out)?;
     eprintln!(
         "{}: {} particles; every run starts after {} steps of plain iteration and lasts {} steps",
         scene.name,
@@ -101,10 +95,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
     .map_err(|e| Failure::Runtime(e.to_string()))?;
     let table = tuning::markdown(&report);
     let text = format!("{table}\n{}\n", conclusion(&report));
-    let mut out = std::io::stdout().lock();
-    out.write_all(text.as_bytes())
-        .and_then(|()| out.flush())
-        .map_err(|e| Failure::Runtime(format!("cannot write to stdout: {e}")))?;
+    print(&text)?;
     write_file(&args.out.join("tune_rho.md"), &text)?;
     write_file(&args.out.join("tune_rho.csv"), &tuning::csv(&report))?;
     write_plots(&args.out, &report)

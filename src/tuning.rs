@@ -221,8 +221,17 @@ pub fn tune_rho(
     if config.steps == 0 {
         return Err(Error::invalid("steps", 0, "must be at least 1"));
     }
-    if config.grid.is_empty() {
-        return Err(Error::invalid("grid", "[]", "must hold at least one ρ"));
+    if config.grid.is_empty()
+        || config
+            .grid
+            .windows(2)
+            .any(|w| w[0].partial_cmp(&w[1]) != Some(std::cmp::Ordering::Less))
+    {
+        return Err(Error::invalid(
+            "grid",
+            format!("{:?}", config.grid),
+            "must hold at least one ρ, in ascending order",
+        ));
     }
     let length = RunLength::Steps(config.steps);
 

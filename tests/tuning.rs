@@ -28,6 +28,7 @@ fn tuned_rho_beats_plain_iteration_on_the_small_dam_break() {
     assert_eq!(best.rejection, None);
     assert_eq!(best.summary.solver, "chebyshev");
     assert_eq!(best.summary.rho, best.rho);
+    assert_eq!(report.best_rho(), Some(best.rho));
     assert!(
         best.summary.outer_iterations_mean < plain.outer_iterations_mean,
         "{} vs {}",
@@ -39,4 +40,21 @@ fn tuned_rho_beats_plain_iteration_on_the_small_dam_break() {
         // Deterministic snapshot: every run starts with the same energy.
         assert_eq!(trial.summary.energy_initial, plain.energy_initial);
     }
+}
+
+#[test]
+fn tuning_rejects_an_unordered_grid_and_zero_steps() {
+    let scene = Scene::builtin("dam_break_small").unwrap();
+    let unordered = TuneConfig {
+        grid: vec![0.9, 0.8],
+        ..TuneConfig::default()
+    };
+    let e = tune_rho(&scene, &unordered, |_| {}).unwrap_err();
+    assert!(e.to_string().contains("ascending"), "{e}");
+    let no_steps = TuneConfig {
+        steps: 0,
+        ..TuneConfig::default()
+    };
+    let e = tune_rho(&scene, &no_steps, |_| {}).unwrap_err();
+    assert!(e.to_string().starts_with("steps"), "{e}");
 }

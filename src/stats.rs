@@ -66,8 +66,8 @@ pub struct RunSummary {
     pub cpu_ms_per_step: Option<f64>,
     /// Mean outer iterations per step.
     pub outer_iterations_mean: f64,
-    /// Mean inner (linear-solver) iterations per step: Jacobi sweeps or CG iterations summed
-    /// over the step's outer iterations; 0 for the direct solver.
+    /// Mean inner (linear-solver) iterations per step: Jacobi sweeps, CG iterations or direct
+    /// solves, summed over the step's outer iterations.
     pub inner_iterations_mean: f64,
     /// Steps whose outer loop ended at its iteration limit instead of the displacement rule.
     pub max_iteration_hits: u64,

@@ -6,8 +6,10 @@
 //! The estimators ([`fit_contraction`], [`contraction_estimate`], [`median`]) work on any δ_k
 //! sequence, e.g. [`crate::World::last_displacements`], so an online choice of ρ can use them too.
 
+mod charts;
 mod table;
 
+pub use charts::charts;
 pub use table::{csv, markdown};
 
 use crate::bench::above;

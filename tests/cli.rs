@@ -261,6 +261,16 @@ fn scenes_lists_builtins_with_particle_counts() {
     );
 }
 
+/// Asserts that `path` holds a PNG image.
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "{}",
+        path.display()
+    );
+}
+
 /// Parses a CSV file written by `bench` or `tune-rho` into a header and rows of cells.
 fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
     let text = std::fs::read_to_string(path).unwrap();
@@ -337,6 +347,8 @@ fn bench_writes_one_consistent_row_per_scene_and_solver() {
     let inner = |i: usize| number(&header, &rows[i], "inner_iterations_mean");
     assert_eq!(inner(1), outer("jacobi1"));
     assert!(inner(3) > 2.0 * outer("cg"));
+    assert_png(&out_dir.join("bench.png"));
+    assert_png(&out_dir.join("bench_iterations.png"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -441,5 +453,7 @@ fn tune_rho_writes_a_row_per_rho_and_names_the_choice() {
     for row in &rows {
         assert!(number(&header, row, "outer_iterations_mean") >= 1.0);
     }
+    assert_png(&dir.join("tune_rho_time.png"));
+    assert_png(&dir.join("tune_rho_iterations.png"));
     std::fs::remove_dir_all(&dir).unwrap();
 }

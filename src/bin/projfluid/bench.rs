@@ -23,7 +23,7 @@ pub(crate) struct BenchArgs {
     steps: u64,
     #[command(flatten)]
     params: ParamOptions,
-    /// Directory for bench.md, bench.csv and bench.png, created if missing.
+    /// Directory for bench.md, bench.csv, bench.png and bench_iterations.png, created if missing.
     #[arg(long, value_name = "DIR", default_value = "bench_results")]
     out: PathBuf,
 }
@@ -98,7 +98,13 @@ pub(crate) fn write_file(path: &Path, text: &str) -> Result<(), Failure> {
         .map_err(|e| Failure::Runtime(format!("cannot write {}: {e}", path.display())))
 }
 
-/// The bar chart of milliseconds per step (not written yet).
-fn write_chart(_dir: &Path, _rows: &[BenchRow]) -> Result<(), Failure> {
+/// Writes bench.png (wall-clock ms per step) and bench_iterations.png (outer iterations).
+fn write_chart(dir: &Path, rows: &[BenchRow]) -> Result<(), Failure> {
+    let [time, iterations] = bench::charts(rows);
+    for (chart, file) in [(time, "bench.png"), (iterations, "bench_iterations.png")] {
+        chart
+            .write_png(&dir.join(file))
+            .map_err(|e| Failure::Runtime(e.to_string()))?;
+    }
     Ok(())
 }

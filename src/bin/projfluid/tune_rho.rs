@@ -126,7 +126,16 @@ fn conclusion(report: &TuneReport) -> String {
     format!("{estimate}\n{choice}")
 }
 
-/// Plots of time and outer iterations over ρ (not written yet).
-fn write_plots(_dir: &Path, _report: &TuneReport) -> Result<(), Failure> {
+/// Writes tune_rho_time.png and tune_rho_iterations.png: time and outer iterations over ρ.
+fn write_plots(dir: &Path, report: &TuneReport) -> Result<(), Failure> {
+    let [time, iterations] = tuning::charts(report);
+    for (chart, file) in [
+        (time, "tune_rho_time.png"),
+        (iterations, "tune_rho_iterations.png"),
+    ] {
+        chart
+            .write_png(&dir.join(file))
+            .map_err(|e| Failure::Runtime(e.to_string()))?;
+    }
     Ok(())
 }

@@ -1,12 +1,12 @@
 //! Runs one scene with one solver configuration and prints a JSON line of what the defaults
-//! are chosen by: outer iterations, density errors, energy rise, time per step.
+//! are chosen by: outer iterations, density errors, energy rise, time per step. Energies are
+//! measured above the lowest fluid particle at the start (`projfluid::driver::energy_datum`).
 //!
 //! `cargo run --release --example calibrate -- SCENE SECONDS SOLVER RHO DELAY OMEGA2 TAU_PER_R`
 //! e.g. `… dam_break_30k 1.0 chebyshev 0.9 3 chebyshev 1e-3`.
+use projfluid::driver::{self, RunLength};
 use projfluid::scene::Scene;
-use projfluid::stats::RunAccumulator;
 use projfluid::{Omega2Rule, SolverKind};
-use std::time::Instant;
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -27,17 +27,7 @@ fn main() {
     p.chebyshev.omega2_rule = Omega2Rule::from_name(&a[5]).expect("omega2");
     p.displacement_tolerance = a[6].parse::<f64>().expect("tau") * p.particle_radius;
     let mut world = scene.build_world().expect("world");
-    let energy = |w: &projfluid::World| w.kinetic_energy() + w.potential_energy();
-    let e0 = energy(&world);
-    let (mut e_max, mut hits) = (e0, 0);
-    let mut acc = RunAccumulator::default();
-    while world.time() < seconds - 1e-12 {
-        let t = Instant::now();
-        let stats = world.step().expect("step").clone();
-        acc.add(&stats, t.elapsed().as_secs_f64());
-        hits += stats.hit_max_iterations as usize;
-        e_max = e_max.max(energy(&world));
-    }
+    let acc = driver::run_quietly(&mut world, RunLength::Duration(seconds)).expect("run");
     let s = acc.summary(&a[0], &world);
     println!(
         "{{\"scene\":\"{}\",\"solver\":\"{}\",\"rho\":\"{}\",\"rho_mean\":{:.3},\"delay\":{},\"omega2\":\"{}\",\"tau_per_r\":{},\"steps\":{},\"outer_mean\":{:.3},\"ms_per_step\":{:.2},\"err_avg_pct\":{:.5},\"err_max_pct\":{:.3},\"energy_rise_j\":{:.4},\"energy_end_j\":{:.3},\"e0\":{:.3},\"kmax_hits\":{},\"escaped\":{},\"nan\":{}}}",
@@ -53,10 +43,10 @@ fn main() {
         s.wall_ms_per_step,
         s.density_error_avg_percent,
         s.density_error_max_percent,
-        e_max - e0,
-        energy(&world),
-        e0,
-        hits,
+        s.energy_max - s.energy_initial,
+        s.energy_final,
+        s.energy_initial,
+        s.max_iteration_hits,
         s.escaped,
         s.nan
     );

@@ -14,8 +14,10 @@
 //!
 //! Units are SI throughout: metres, seconds, kilograms.
 
+pub mod bench;
 pub mod boundary;
 pub mod constraint;
+pub mod driver;
 mod error;
 pub mod ffi;
 pub mod io;
@@ -28,6 +30,8 @@ pub mod scene;
 pub mod solver;
 pub mod stats;
 mod step;
+mod table;
+pub mod tuning;
 pub mod validation;
 mod world;
 

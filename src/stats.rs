@@ -66,8 +66,17 @@ pub struct RunSummary {
     pub sim_time: f64,
     /// Mean wall-clock time per step (ms).
     pub wall_ms_per_step: f64,
+    /// Mean processor time per step, summed over all threads of the process (ms); less
+    /// sensitive than wall time to other programs on a shared machine. `None` where the
+    /// platform does not report it.
+    pub cpu_ms_per_step: Option<f64>,
     /// Mean outer iterations per step.
     pub outer_iterations_mean: f64,
+    /// Mean inner (linear-solver) iterations per step: Jacobi sweeps, CG iterations or direct
+    /// solves, summed over the step's outer iterations.
+    pub inner_iterations_mean: f64,
+    /// Steps whose outer loop ended at its iteration limit instead of the displacement rule.
+    pub max_iteration_hits: u64,
     /// Mean over steps of the mean compression (percent).
     pub density_error_avg_percent: f64,
     /// Largest compression of any particle in any step (percent).
@@ -80,6 +89,22 @@ pub struct RunSummary {
     pub positions_hash: String,
     /// Mean milliseconds per step in neighbour search / local step / global step / rest.
     pub ms_per_step_breakdown: [f64; 4],
+    /// Total energy (kinetic plus potential, see [`RunAccumulator::record_energy`]) at the
+    /// start of the run (J).
+    pub energy_initial: f64,
+    /// Largest total energy at the start or after any step (J).
+    pub energy_max: f64,
+    /// Total energy after the last step (J).
+    pub energy_final: f64,
+}
+
+impl RunSummary {
+    /// How far the total energy rose above its initial value at its highest, as a fraction of
+    /// the initial value: 0 when it never rose, `None` when the initial energy is not positive.
+    pub fn energy_rise(&self) -> Option<f64> {
+        (self.energy_initial > 0.0)
+            .then(|| (self.energy_max - self.energy_initial) / self.energy_initial)
+    }
 }
 
 /// Accumulates step statistics into a [`RunSummary`].
@@ -88,7 +113,11 @@ pub struct RunAccumulator {
     steps: u64,
     sim_time: f64,
     wall_seconds: f64,
+    cpu_seconds: Option<f64>,
     outer: u64,
+    inner: u64,
+    max_iteration_hits: u64,
+    energy: Option<EnergyRecord>,
     density_avg_sum: f64,
     density_max: f64,
     rho_sum: f64,
@@ -107,6 +136,8 @@ impl RunAccumulator {
             self.rho_sum += step.rho;
             self.rho_steps += 1;
         }
+        self.inner += step.inner_iterations as u64;
+        self.max_iteration_hits += u64::from(step.hit_max_iterations);
         self.density_avg_sum += step.density_error_avg;
         self.density_max = self.density_max.max(step.density_error_max);
         let t = &step.timings;
@@ -119,6 +150,24 @@ impl RunAccumulator {
         }
     }
 
+    /// Adds the processor time (s, all threads) of the steps added since the last call.
+    pub fn add_cpu_time(&mut self, seconds: f64) {
+        *self.cpu_seconds.get_or_insert(0.0) += seconds;
+    }
+
+    /// Records the total energy (J) at the start of the run (first call) or after a step.
+    /// The run driver measures it above a datum fixed at the start, see
+    /// [`crate::driver::total_energy`].
+    pub fn record_energy(&mut self, joules: f64) {
+        let e = self.energy.get_or_insert(EnergyRecord {
+            initial: joules,
+            max: joules,
+            last: joules,
+        });
+        e.max = e.max.max(joules);
+        e.last = joules;
+    }
+
     /// Steps added so far.
     pub fn steps(&self) -> u64 {
         self.steps
@@ -128,6 +177,7 @@ impl RunAccumulator {
     pub fn summary(&self, scene: &str, world: &World) -> RunSummary {
         let n = self.steps.max(1) as f64;
         let p = world.params();
+        let energy = self.energy.unwrap_or_default();
         RunSummary {
             scene: scene.to_string(),
             solver: p.solver.name().to_string(),
@@ -145,13 +195,27 @@ impl RunAccumulator {
             steps: self.steps,
             sim_time: self.sim_time,
             wall_ms_per_step: self.wall_seconds * 1e3 / n,
+            cpu_ms_per_step: self.cpu_seconds.map(|s| s * 1e3 / n),
             outer_iterations_mean: self.outer as f64 / n,
+            inner_iterations_mean: self.inner as f64 / n,
+            max_iteration_hits: self.max_iteration_hits,
             density_error_avg_percent: self.density_avg_sum * 100.0 / n,
             density_error_max_percent: self.density_max * 100.0,
             escaped: world.escaped_count(),
             nan: world.nan_count(),
             positions_hash: world.positions_hash(),
             ms_per_step_breakdown: self.breakdown.map(|s| s * 1e3 / n),
+            energy_initial: energy.initial,
+            energy_max: energy.max,
+            energy_final: energy.last,
         }
     }
+}
+
+/// Total energy at the start, its maximum and its latest value (J).
+#[derive(Clone, Copy, Debug, Default)]
+struct EnergyRecord {
+    initial: f64,
+    max: f64,
+    last: f64,
 }

@@ -117,6 +117,18 @@ impl World {
         Ok(())
     }
 
+    /// Changes the outer loop's iteration limits between steps: at least `min` and at most
+    /// `max` outer iterations per step (min = max forces a fixed count, as ρ estimation
+    /// needs). Rejects values that [`Params::validate`] rejects, changing nothing.
+    pub fn set_outer_iterations(&mut self, min: usize, max: usize) -> Result<(), Error> {
+        let mut params = self.params.clone();
+        params.min_outer_iterations = min;
+        params.max_outer_iterations = max;
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
     /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
     /// Rejects non-finite values and length mismatches without changing the world.
     pub fn add_fluid_particles(

@@ -286,3 +286,200 @@ fn rho_auto_runs_and_reports_its_estimate() {
     let rho = json["rho"].as_f64().unwrap();
     assert!((0.5..=0.95).contains(&rho) && rho != 0.85, "mean rho {rho}");
 }
+
+/// Asserts that `path` holds a PNG image.
+fn assert_png(path: &Path) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert!(
+        bytes.starts_with(b"\x89PNG\r\n\x1a\n"),
+        "{}",
+        path.display()
+    );
+}
+
+/// Parses a CSV file written by `bench` or `tune-rho` into a header and rows of cells.
+fn read_csv(path: &Path) -> (Vec<String>, Vec<Vec<String>>) {
+    let text = std::fs::read_to_string(path).unwrap();
+    let mut lines = text
+        .lines()
+        .map(|l| l.split(',').map(String::from).collect());
+    let header: Vec<String> = lines.next().unwrap();
+    let rows: Vec<Vec<String>> = lines.collect();
+    assert!(rows.iter().all(|r| r.len() == header.len()), "{text}");
+    (header, rows)
+}
+
+/// The cell of `row` under `column`, parsed as a number.
+fn number(header: &[String], row: &[String], column: &str) -> f64 {
+    let i = header.iter().position(|h| h == column).unwrap();
+    row[i]
+        .parse()
+        .unwrap_or_else(|_| panic!("{column}: {:?}", row[i]))
+}
+
+/// On formulation F1 the exact global solvers follow one trajectory, so over the first steps
+/// they need the same outer iterations; cg1 is not exact and needs a different number.
+#[test]
+fn bench_writes_one_consistent_row_per_scene_and_solver() {
+    let dir = temp_dir("bench");
+    let out_dir = dir.join("out");
+    let out = projfluid(&[
+        "bench",
+        "--scenes",
+        "dam_break_small",
+        "--steps",
+        "15",
+        "--threads",
+        "1",
+        "--out",
+        out_dir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    let markdown = std::fs::read_to_string(out_dir.join("bench.md")).unwrap();
+    assert_eq!(String::from_utf8_lossy(&out.stdout), markdown);
+    assert_eq!(markdown.lines().count(), 2 + 6);
+    let (header, rows) = read_csv(&out_dir.join("bench.csv"));
+    let solvers: Vec<&str> = rows.iter().map(|r| r[1].as_str()).collect();
+    assert_eq!(
+        solvers,
+        ["chebyshev", "jacobi1", "jacobi", "cg", "cg1", "ldlt"]
+    );
+    let outer = |solver: &str| {
+        let row = &rows[solvers.iter().position(|s| *s == solver).unwrap()];
+        number(&header, row, "outer_iterations_mean")
+    };
+    for row in &rows {
+        assert_eq!(row[0], "dam_break_small");
+        assert_eq!(number(&header, row, "particles"), 3840.0);
+        assert_eq!(number(&header, row, "steps"), 15.0);
+        assert!(number(&header, row, "ms_per_step") > 0.0);
+        let avg = number(&header, row, "density_error_avg_percent");
+        let max = number(&header, row, "density_error_max_percent");
+        assert!(0.0 < avg && avg <= max && max < 1.0, "{row:?}");
+        assert_eq!(number(&header, row, "max_iteration_hits"), 0.0);
+        assert_eq!(number(&header, row, "energy_rise_percent"), 0.0);
+        assert_eq!(row.last().unwrap(), "none");
+    }
+    assert!(
+        outer("jacobi1") > 1.0,
+        "the scene must exercise the constraint"
+    );
+    for exact in ["jacobi", "cg", "ldlt"] {
+        assert_eq!(outer(exact), outer("jacobi1"), "{exact}");
+    }
+    assert_ne!(outer("cg1"), outer("jacobi1"));
+    // One Jacobi sweep per outer iteration; converged CG needs several per outer iteration.
+    let inner = |i: usize| number(&header, &rows[i], "inner_iterations_mean");
+    assert_eq!(inner(1), outer("jacobi1"));
+    assert!(inner(3) > 2.0 * outer("cg"));
+    assert_png(&out_dir.join("bench.png"));
+    assert_png(&out_dir.join("bench_iterations.png"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// A stopping threshold of half a particle radius leaves the fluid visibly compressed; the
+/// artifacts rule must say so.
+#[test]
+fn bench_flags_artifacts_of_a_far_too_loose_tolerance() {
+    let dir = temp_dir("bench-loose");
+    let out = projfluid(&[
+        "bench",
+        "--scenes",
+        "dam_break_small",
+        "--solvers",
+        "jacobi1",
+        "--steps",
+        "30",
+        "--tau",
+        "0.0125",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let (header, rows) = read_csv(&dir.join("bench.csv"));
+    assert_eq!(rows.len(), 1);
+    assert!(number(&header, &rows[0], "density_error_max_percent") > 3.0);
+    assert!(
+        rows[0].last().unwrap().contains("max density error"),
+        "{:?}",
+        rows[0]
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn bench_and_tune_rho_reject_bad_options_with_exit_2() {
+    let cases: [(&[&str], &[&str]); 9] = [
+        (&["bench", "--steps", "0"], &["--steps", "0"]),
+        (&["bench", "--scenes", "dam_break_small,nope"], &["nope"]),
+        (&["bench", "--solvers", "cg,sor"], &["--solvers", "sor"]),
+        (&["bench", "--rho", "1.5"], &["--rho", "1.5"]),
+        (&["bench", "--tau", "0"], &["--tau", "0"]),
+        (&["tune-rho", "nope"], &["nope"]),
+        (
+            &["tune-rho", "dam_break_small", "--from", "-0.1"],
+            &["--from", "-0.1"],
+        ),
+        (
+            &[
+                "tune-rho",
+                "dam_break_small",
+                "--from",
+                "0.9",
+                "--to",
+                "0.8",
+            ],
+            &["--to", "0.8"],
+        ),
+        (
+            &["tune-rho", "dam_break_small", "--steps", "0"],
+            &["--steps", "0"],
+        ),
+    ];
+    for (args, parts) in cases {
+        assert_bad_input(&projfluid(args), parts);
+    }
+}
+
+#[test]
+fn tune_rho_writes_a_row_per_rho_and_names_the_choice() {
+    let dir = temp_dir("tune-rho");
+    let out = projfluid(&[
+        "tune-rho",
+        "dam_break_small",
+        "--warmup",
+        "3",
+        "--steps",
+        "2",
+        "--from",
+        "0.8",
+        "--to",
+        "0.9",
+        "--step",
+        "0.1",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("best rho: "), "{stdout}");
+    assert_eq!(
+        std::fs::read_to_string(dir.join("tune_rho.md")).unwrap(),
+        stdout
+    );
+    let (header, rows) = read_csv(&dir.join("tune_rho.csv"));
+    let labels: Vec<&str> = rows.iter().map(|r| r[0].as_str()).collect();
+    assert_eq!(labels, ["plain", "0.8", "0.9"]);
+    for row in &rows {
+        assert!(number(&header, row, "outer_iterations_mean") >= 1.0);
+    }
+    assert_png(&dir.join("tune_rho_time.png"));
+    assert_png(&dir.join("tune_rho_iterations.png"));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

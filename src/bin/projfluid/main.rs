@@ -8,12 +8,18 @@
 //!                                 [--solver S] [--threads N] [--out DIR]
 //! projfluid validate hydrostatic [--count NX,NY,NZ] [--settle SECONDS] [--tau METRES]
 //!                                [--solver S] [--threads N] [--out DIR]
+//! projfluid bench [--scenes A,B,…] [--solvers A,B,…] [--steps N] [--rho R] [--tau METRES]
+//!                 [--threads N] [--out DIR]
+//! projfluid tune-rho SCENE [--steps T] [--warmup N] [--from R] [--to R] [--step R]
+//!                    [--tau METRES] [--threads N] [--out DIR]
 //! ```
 //!
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
 //! Each subcommand lives in its own module.
 
+mod bench;
 mod run;
+mod tune_rho;
 mod validate;
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
@@ -45,6 +51,10 @@ enum Command {
     /// Compare the solver with experiment and analytic solutions (writes CSV and PNG files).
     #[command(subcommand)]
     Validate(validate::ValidateCommand),
+    /// Run scenes with several solvers and tabulate cost, accuracy and artifacts.
+    Bench(bench::BenchArgs),
+    /// Choose Chebyshev's ρ for a scene: estimate it, then sweep it.
+    TuneRho(tune_rho::TuneRhoArgs),
 }
 
 /// Why the program stops early; decides the exit code.
@@ -100,6 +110,8 @@ fn main() -> ExitCode {
         Command::Run(args) => run::run(&args),
         Command::Scenes => list_scenes(),
         Command::Validate(command) => validate::validate(&command),
+        Command::Bench(args) => bench::bench(&args),
+        Command::TuneRho(args) => tune_rho::tune_rho(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -3,14 +3,14 @@
 use crate::{Failure, RhoArg, rho_parser, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use projfluid::driver::{self, RunError, RunLength, StepReport};
 use projfluid::io::write_vtk;
 use projfluid::scene::Scene;
-use projfluid::stats::{RunAccumulator, RunSummary, StepStats};
+use projfluid::stats::RunSummary;
 use projfluid::{Error, SolverKind, World};
 use std::fs::File;
 use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
-use std::time::Instant;
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
 #[derive(Args)]
@@ -31,15 +31,8 @@ pub(crate) struct RunArgs {
     /// Global solver (the README's "Command line" section describes each).
     #[arg(long, value_parser = solver_parser())]
     solver: Option<SolverKind>,
-    /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
-    #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
-    rho: Option<RhoArg>,
-    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
-    tau: Option<f64>,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N")]
-    threads: Option<usize>,
+    #[command(flatten)]
+    params: ParamOptions,
     /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
@@ -51,13 +44,67 @@ pub(crate) struct RunArgs {
     stats: Option<PathBuf>,
 }
 
-/// How long to run.
-#[derive(Clone, Copy)]
-enum Target {
-    /// Simulated seconds.
-    Time(f64),
-    /// Steps.
-    Steps(u64),
+/// Solver settings that every subcommand running scenes accepts; each given option replaces
+/// the scene's setting.
+#[derive(Args)]
+pub(crate) struct ParamOptions {
+    /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
+    #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
+    pub(crate) rho: Option<RhoArg>,
+    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub(crate) tau: Option<f64>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N")]
+    pub(crate) threads: Option<usize>,
+}
+
+impl ParamOptions {
+    /// Sets the given options in `scene.params`.
+    fn apply(&self, scene: &mut Scene) {
+        let p = &mut scene.params;
+        if let Some(rho) = self.rho {
+            rho.apply(&mut p.chebyshev);
+        }
+        if let Some(tau) = self.tau {
+            p.displacement_tolerance = tau;
+        }
+        if let Some(threads) = self.threads {
+            p.threads = threads;
+        }
+    }
+
+    /// Which scene key each option sets, and whether it was given.
+    fn keys(&self) -> [(&'static str, &'static str, bool); 3] {
+        [
+            ("solver.rho", "--rho", self.rho.is_some()),
+            ("solver.tau", "--tau", self.tau.is_some()),
+            ("threads", "--threads", self.threads.is_some()),
+        ]
+    }
+
+    /// Applies the options to `scene` and validates it; an error caused by an option names
+    /// the option instead of the scene key.
+    pub(crate) fn apply_checked(&self, scene: &mut Scene) -> Result<(), Failure> {
+        self.apply(scene);
+        validate_naming_options(scene, &self.keys())
+    }
+}
+
+/// Validates `scene`; when the error is about a scene key set by a given option (key, option,
+/// given), the message names the option.
+fn validate_naming_options(scene: &Scene, options: &[(&str, &str, bool)]) -> Result<(), Failure> {
+    scene.validate().map_err(|e| {
+        let msg = e.to_string();
+        if let Error::InvalidArgument { field, .. } = &e {
+            for &(key, option, given) in options {
+                if given && field == key {
+                    return Failure::Input(msg.replacen(key, option, 1));
+                }
+            }
+        }
+        Failure::Input(msg)
+    })
 }
 
 /// `projfluid run`.
@@ -85,8 +132,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         f.write(&world)?;
     }
     let goal = match target {
-        Target::Time(d) => format!("{d} s simulated"),
-        Target::Steps(n) => format!("{n} steps"),
+        RunLength::Duration(d) => format!("{d} s simulated"),
+        RunLength::Steps(n) => format!("{n} steps"),
     };
     eprintln!(
         "{}: {} particles, {} boundary particles, {} solver, {goal}",
@@ -95,39 +142,20 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         world.boundary_count(),
         scene.params.solver.name()
     );
-    let mut acc = RunAccumulator::default();
     let mut progress = Progress::new(target);
-    let (start, end) = (world.time(), world.time() + scene.duration);
-    loop {
-        let dt = match target {
-            Target::Time(_) => {
-                let left = end - world.time();
-                if left <= 1e-12 * end.abs().max(1.0) {
-                    break;
-                }
-                world.next_dt().min(left)
-            }
-            Target::Steps(n) if acc.steps() >= n => break,
-            Target::Steps(_) => world.next_dt(),
-        };
-        let clock = Instant::now();
-        let stats = world
-            .step_with_dt(dt)
-            .map_err(|e| Failure::Runtime(format!("step {} failed: {e}", acc.steps() + 1)))?
-            .clone();
-        let wall = clock.elapsed().as_secs_f64();
-        acc.add(&stats, wall);
+    let acc = driver::run(&mut world, target, |report| {
         if let Some(f) = frames.as_mut() {
-            if acc.steps() % f.every as u64 == 0 {
-                f.write(&world)?;
+            if report.steps % f.every as u64 == 0 {
+                f.write(report.world)?;
             }
         }
-        let done = match target {
-            Target::Time(d) => (world.time() - start) / d,
-            Target::Steps(n) => acc.steps() as f64 / n as f64,
-        };
-        progress.update(done, &world, &stats, wall);
-    }
+        progress.update(report);
+        Ok(())
+    })
+    .map_err(|e| match e {
+        RunError::Step { step, error } => Failure::Runtime(format!("step {step} failed: {error}")),
+        RunError::Callback(failure) => failure,
+    })?;
     progress.finish();
     let summary = acc.summary(&scene.name, &world);
     print_summary(&summary)
@@ -149,20 +177,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
 }
 
 /// Applies the command-line overrides to `scene` and checks the result; errors name the option.
-fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure> {
-    let p = &mut scene.params;
+fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failure> {
     if let Some(s) = args.solver {
-        p.solver = s;
+        scene.params.solver = s;
     }
-    if let Some(rho) = args.rho {
-        rho.apply(&mut p.chebyshev);
-    }
-    if let Some(tau) = args.tau {
-        p.displacement_tolerance = tau;
-    }
-    if let Some(threads) = args.threads {
-        p.threads = threads;
-    }
+    args.params.apply(scene);
     if let Some(every) = args.every {
         scene.output.every = every;
     }
@@ -177,28 +196,15 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure>
             Error::invalid("--steps", 0, "must be at least 1").to_string(),
         ));
     }
-    // Which scene key each option sets, to name the option in errors.
-    let options = [
-        ("solver.rho", "--rho", args.rho.is_some()),
-        ("solver.tau", "--tau", args.tau.is_some()),
-        ("threads", "--threads", args.threads.is_some()),
+    let mut options = args.params.keys().to_vec();
+    options.extend([
         ("output.every", "--every", args.every.is_some()),
         ("duration", "--duration", args.duration.is_some()),
-    ];
-    scene.validate().map_err(|e| {
-        let msg = e.to_string();
-        if let Error::InvalidArgument { field, .. } = &e {
-            for (key, option, given) in options {
-                if given && field == key {
-                    return Failure::Input(msg.replacen(key, option, 1));
-                }
-            }
-        }
-        Failure::Input(msg)
-    })?;
+    ]);
+    validate_naming_options(scene, &options)?;
     Ok(match args.steps {
-        Some(n) => Target::Steps(n),
-        None => Target::Time(scene.duration),
+        Some(n) => RunLength::Steps(n),
+        None => RunLength::Duration(scene.duration),
     })
 }
 
@@ -250,7 +256,7 @@ struct Progress {
 }
 
 impl Progress {
-    fn new(target: Target) -> Self {
+    fn new(target: RunLength) -> Self {
         let bar = std::io::stderr().is_terminal().then(|| {
             let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
             let style = ProgressStyle::with_template(
@@ -258,7 +264,7 @@ impl Progress {
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar());
             bar.set_style(style);
-            if let Target::Steps(n) = target {
+            if let RunLength::Steps(n) = target {
                 bar.set_message(format!("0/{n} steps"));
             }
             bar
@@ -272,14 +278,18 @@ impl Progress {
         }
     }
 
-    /// Records a step that took `wall` seconds; `done` is the finished fraction of the run.
-    fn update(&mut self, done: f64, world: &World, step: &StepStats, wall: f64) {
+    /// Records a finished step.
+    fn update(&mut self, report: &StepReport<'_>) {
         self.steps += 1;
-        self.wall += wall;
-        self.outer += step.outer_iterations as u64;
+        self.wall += report.wall_seconds;
+        self.outer += report.stats.outer_iterations as u64;
         let n = self.steps as f64;
-        let (t, ms, outer) = (world.time(), self.wall * 1e3 / n, self.outer as f64 / n);
-        let done = done.clamp(0.0, 1.0);
+        let (t, ms, outer) = (
+            report.world.time(),
+            self.wall * 1e3 / n,
+            self.outer as f64 / n,
+        );
+        let done = report.done;
         match &self.bar {
             Some(bar) => {
                 bar.set_position((done * 1000.0).round() as u64);

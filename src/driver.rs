@@ -1,0 +1,239 @@
+//! Runs a world for a number of steps or a span of simulated time and accumulates its step
+//! statistics and total energy into a [`RunAccumulator`]; the CLI, the benchmark and ρ tuning
+//! all run worlds through it.
+
+use crate::stats::{RunAccumulator, StepStats};
+use crate::{Error, Vec3, World};
+use std::fmt;
+use std::time::Instant;
+
+/// How long a run lasts.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum RunLength {
+    /// This many CFL-limited steps.
+    Steps(u64),
+    /// This much simulated time (s); the last step is shortened to land exactly.
+    Duration(f64),
+}
+
+/// What the driver tells its caller after every step.
+pub struct StepReport<'a> {
+    /// The world after the step.
+    pub world: &'a World,
+    /// The step's statistics.
+    pub stats: &'a StepStats,
+    /// Wall-clock time of the step alone (s).
+    pub wall_seconds: f64,
+    /// Processor time of the step alone, all threads of the process (s), where available.
+    pub cpu_seconds: Option<f64>,
+    /// Steps taken in this run so far, this one included.
+    pub steps: u64,
+    /// Finished fraction of the run, in [0, 1].
+    pub done: f64,
+}
+
+/// Why a run stopped early.
+#[derive(Debug, PartialEq)]
+pub enum RunError<E> {
+    /// Step number `step` (1-based within the run) failed.
+    Step {
+        /// The failing step, counted from 1 within this run.
+        step: u64,
+        /// Why it failed.
+        error: Error,
+    },
+    /// The per-step callback returned an error.
+    Callback(E),
+}
+
+impl<E: fmt::Display> fmt::Display for RunError<E> {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            RunError::Step { step, error } => write!(f, "step {step} failed: {error}"),
+            RunError::Callback(e) => e.fmt(f),
+        }
+    }
+}
+
+impl From<RunError<std::convert::Infallible>> for Error {
+    fn from(e: RunError<std::convert::Infallible>) -> Self {
+        match e {
+            RunError::Step { step, error } => match error {
+                Error::InvalidArgument { field, message } => Error::InvalidArgument {
+                    field,
+                    message: format!("step {step} failed: {message}"),
+                },
+                Error::Io(message) => Error::Io(format!("step {step} failed: {message}")),
+            },
+            RunError::Callback(never) => match never {},
+        }
+    }
+}
+
+/// Runs `world` for `length`, calling `on_step` after every step, and returns the statistics
+/// of the steps taken, with the total energy (above [`energy_datum`] of the world as it was
+/// at the start) recorded before the first step and after each one. Only the step itself is
+/// timed, not the energy or the callback. Stops at the first failing step or callback error.
+pub fn run<E>(
+    world: &mut World,
+    length: RunLength,
+    mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
+) -> Result<RunAccumulator, RunError<E>> {
+    if let RunLength::Duration(d) = length {
+        if !(d.is_finite() && d >= 0.0) {
+            return Err(RunError::Step {
+                step: 1,
+                error: Error::invalid("duration", d, "must be a non-negative finite number"),
+            });
+        }
+    }
+    let datum = energy_datum(world);
+    let mut acc = RunAccumulator::default();
+    acc.record_energy(total_energy(world, datum));
+    let start = world.time();
+    loop {
+        let dt = match length {
+            RunLength::Steps(n) if acc.steps() >= n => break,
+            RunLength::Steps(_) => world.next_dt(),
+            RunLength::Duration(d) => {
+                let end = start + d;
+                let left = end - world.time();
+                if left <= 1e-12 * end.abs().max(1.0) {
+                    break;
+                }
+                world.next_dt().min(left)
+            }
+        };
+        let (clock, cpu) = (Instant::now(), process_cpu_seconds());
+        let stats = match world.step_with_dt(dt) {
+            Ok(stats) => stats.clone(),
+            Err(error) => {
+                let step = acc.steps() + 1;
+                return Err(RunError::Step { step, error });
+            }
+        };
+        let wall_seconds = clock.elapsed().as_secs_f64();
+        let cpu_seconds = cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a);
+        acc.add(&stats, wall_seconds);
+        if let Some(cpu) = cpu_seconds {
+            acc.add_cpu_time(cpu);
+        }
+        acc.record_energy(total_energy(world, datum));
+        let done = match length {
+            RunLength::Steps(n) => acc.steps() as f64 / n as f64,
+            RunLength::Duration(d) if d > 0.0 => (world.time() - start) / d,
+            RunLength::Duration(_) => 1.0,
+        };
+        let report = StepReport {
+            world,
+            stats: &stats,
+            wall_seconds,
+            cpu_seconds,
+            steps: acc.steps(),
+            done: done.clamp(0.0, 1.0),
+        };
+        on_step(&report).map_err(RunError::Callback)?;
+    }
+    Ok(acc)
+}
+
+/// Processor time (s) used so far by all threads of this process, user plus system.
+#[cfg(unix)]
+fn process_cpu_seconds() -> Option<f64> {
+    // SAFETY: getrusage only writes the struct it is given.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } != 0 {
+        return None;
+    }
+    let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+    Some(seconds(usage.ru_utime) + seconds(usage.ru_stime))
+}
+
+/// Not reported on this platform.
+#[cfg(not(unix))]
+fn process_cpu_seconds() -> Option<f64> {
+    None
+}
+
+/// [`run`] without a per-step callback.
+pub fn run_quietly(world: &mut World, length: RunLength) -> Result<RunAccumulator, Error> {
+    Ok(run(world, length, |_| {
+        Ok::<(), std::convert::Infallible>(())
+    })?)
+}
+
+/// The potential energy (J) the fluid would have if every particle sat as low, along gravity,
+/// as the lowest one does now: N·min_i(−m g·x_i). Energies measured above it are positive for
+/// a fluid at rest above its floor, so a relative energy rise is meaningful. Zero without
+/// fluid or gravity.
+pub fn energy_datum(world: &World) -> f64 {
+    let g = Vec3::from(world.params().gravity);
+    let m = world.particle_mass();
+    let positions = world.positions();
+    let lowest = positions
+        .iter()
+        .map(|x| -m * g.dot(x))
+        .fold(f64::INFINITY, f64::min);
+    if lowest.is_finite() {
+        lowest * positions.len() as f64
+    } else {
+        0.0
+    }
+}
+
+/// Kinetic plus potential energy of the fluid (J), measured above `datum`
+/// (see [`energy_datum`]).
+pub fn total_energy(world: &World, datum: f64) -> f64 {
+    world.kinetic_energy() + world.potential_energy() - datum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::Scene;
+
+    fn small_world() -> World {
+        let mut scene = Scene::builtin("dam_break_small").unwrap();
+        scene.params.threads = 1;
+        scene.build_world().unwrap()
+    }
+
+    #[test]
+    fn runs_exactly_the_requested_steps_and_reports_each() {
+        let mut world = small_world();
+        let mut seen = Vec::new();
+        let acc = run(&mut world, RunLength::Steps(3), |r| {
+            seen.push((r.steps, r.done, r.stats.outer_iterations));
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+        assert_eq!(acc.steps(), 3);
+        assert_eq!(world.steps(), 3);
+        assert_eq!(seen.iter().map(|s| s.0).collect::<Vec<_>>(), [1, 2, 3]);
+        assert_eq!(seen[2].1, 1.0);
+        assert!(seen.iter().all(|s| s.2 >= 1));
+        let summary = acc.summary("s", &world);
+        if cfg!(unix) {
+            assert!(summary.cpu_ms_per_step.unwrap() > 0.0);
+        }
+        // At rest above its lowest particle the block has positive potential energy; the
+        // dissipative step never adds energy in the first steps of the collapse.
+        assert!(summary.energy_initial > 0.0);
+        assert!(summary.energy_final < summary.energy_initial);
+        assert_eq!(summary.energy_rise(), Some(0.0));
+    }
+
+    #[test]
+    fn duration_lands_exactly_and_callback_errors_stop_the_run() {
+        let mut world = small_world();
+        let acc = run_quietly(&mut world, RunLength::Duration(0.0025)).unwrap();
+        assert!((world.time() - 0.0025).abs() < 1e-12, "{}", world.time());
+        assert!(acc.steps() >= 2);
+        let stopped = run(&mut world, RunLength::Steps(5), |r| {
+            if r.steps == 2 { Err("enough") } else { Ok(()) }
+        });
+        assert_eq!(stopped.unwrap_err(), RunError::Callback("enough"));
+        let bad = run_quietly(&mut world, RunLength::Duration(f64::NAN)).unwrap_err();
+        assert!(bad.to_string().contains("duration"), "{bad}");
+    }
+}

@@ -7,6 +7,9 @@ use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use rayon::prelude::*;
 
 pub mod mesh;
+pub mod transform;
+
+pub use transform::Transform;
 
 /// An axis-aligned box, corners in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]

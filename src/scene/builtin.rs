@@ -53,6 +53,7 @@ fn dam_break(
             max,
             layers: 1,
         }],
+        obstacles: Vec::new(),
         fluid_blocks: vec![FluidBlock {
             start: [0.05; 3],
             count,

@@ -7,7 +7,9 @@ use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use rayon::prelude::*;
 
 pub mod mesh;
+pub mod shapes;
 pub mod transform;
+pub mod winding;
 
 pub use transform::Transform;
 

@@ -23,6 +23,25 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, Error> {
     parse_obj(&text, &path.display().to_string())
 }
 
+/// Writes `mesh` as an OBJ file at `path`: a `#` comment line per entry of `comments`, then
+/// one `v` line per vertex (coordinates in metres, printed so that they read back exactly)
+/// and one `f` line per triangle. Errors name the path.
+pub fn write_obj(path: &Path, mesh: &TriangleMesh, comments: &[&str]) -> Result<(), Error> {
+    use std::fmt::Write as _;
+    let mut text = String::new();
+    for c in comments {
+        let _ = writeln!(text, "# {c}");
+    }
+    for v in mesh.vertices() {
+        let _ = writeln!(text, "v {} {} {}", v.x, v.y, v.z);
+    }
+    for t in mesh.triangles() {
+        let _ = writeln!(text, "f {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1);
+    }
+    std::fs::write(path, text)
+        .map_err(|e| Error::Io(format!("cannot write OBJ file {}: {e}", path.display())))
+}
+
 /// Parses OBJ `text`; `origin` (usually the file name) starts every error message.
 pub fn parse_obj(text: &str, origin: &str) -> Result<TriangleMesh, Error> {
     let at = |line: usize, what: String| Error::InvalidArgument {
@@ -293,6 +312,22 @@ mod tests {
         // The second triangle of a quad's fan.
         let text = format!("{TETRA}v 0 2 0\nf 1 2 3 5\n");
         assert!(error(&text).starts_with("test.obj:11: face `f 1 2 3 5` is degenerate"));
+    }
+
+    #[test]
+    fn written_meshes_read_back_exactly() {
+        let mesh = parse_obj(TETRA, "t.obj").unwrap();
+        let moved = crate::boundary::Transform {
+            rotate_deg: [10.0, 20.0, 30.0],
+            ..Default::default()
+        }
+        .apply(&mesh)
+        .unwrap();
+        let path = std::env::temp_dir().join(format!("projfluid-obj-{}.obj", std::process::id()));
+        write_obj(&path, &moved, &["a tetrahedron", "rotated"]).unwrap();
+        let back = load_obj(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(back, moved);
     }
 
     #[test]

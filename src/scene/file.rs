@@ -74,6 +74,8 @@ struct OutputFile {
 struct ObstacleFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     obj: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    generated: Option<String>,
     scale: Option<Scale>,
     rotate_deg: Option<[f64; 3]>,
     translate: Option<[f64; 3]>,
@@ -91,18 +93,23 @@ impl ObstacleFile {
     /// The obstacle, with a relative `obj` path taken relative to `base` (the scene file's
     /// directory, if any). `i` names the entry in errors.
     fn into_spec(self, i: usize, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
-        let mesh = match self.obj {
-            Some(obj) => {
+        let mesh = match (self.obj, self.generated) {
+            (Some(obj), None) => {
                 let path = PathBuf::from(obj);
                 MeshSource::Obj(match base {
                     Some(dir) if path.is_relative() => dir.join(path),
                     _ => path,
                 })
             }
-            None => {
+            (None, Some(name)) => MeshSource::Generated(name),
+            _ => {
                 return Err(Error::InvalidArgument {
                     field: format!("obstacles[{i}]"),
-                    message: format!("obstacles[{i}] needs a mesh: give `obj` (an OBJ file path)"),
+                    message: format!(
+                        "obstacles[{i}] needs exactly one mesh: `obj` (an OBJ file path) or \
+                         `generated` (one of {})",
+                        super::obstacle::NAMES.join(", ")
+                    ),
                 });
             }
         };
@@ -128,6 +135,11 @@ impl ObstacleFile {
         ObstacleFile {
             obj: match &spec.mesh {
                 MeshSource::Obj(path) => Some(path.to_string_lossy().into_owned()),
+                MeshSource::Generated(_) => None,
+            },
+            generated: match &spec.mesh {
+                MeshSource::Generated(name) => Some(name.clone()),
+                MeshSource::Obj(_) => None,
             },
             scale: Some(if x == y && y == z {
                 Scale::Uniform(x)

@@ -260,3 +260,49 @@ fn scenes_lists_builtins_with_particle_counts() {
         "{stdout}"
     );
 }
+
+#[test]
+fn png_pictures_are_written_at_the_frame_interval() {
+    let dir = temp_dir("png");
+    let pictures = dir.join("pictures");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "4",
+        "--every",
+        "2",
+        "--png",
+        pictures.to_str().unwrap(),
+        "--png-width",
+        "160",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&pictures)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    let decoder = png::Decoder::new(std::fs::File::open(pictures.join("frame_00002.png")).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (160, 90));
+    // The fluid is drawn: many pixels are bluish, unlike the grey background.
+    let blue = buf[..info.buffer_size()]
+        .chunks_exact(3)
+        .filter(|p| p[2] > 120 && p[2] > p[0] + 40)
+        .count();
+    assert!(blue > 100, "{blue} blue pixels");
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--png-width", "3"]);
+    assert_bad_input(&out, &["--png-width", "3"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -9,6 +9,7 @@
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
 //! Each subcommand lives in its own module.
 
+mod frames;
 mod run;
 
 use clap::builder::{PossibleValuesParser, TypedValueParser};
@@ -34,7 +35,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene and print a summary of the run.
-    Run(run::RunArgs),
+    Run(Box<run::RunArgs>),
     /// List the built-in scenes.
     Scenes,
 }

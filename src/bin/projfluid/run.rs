@@ -1,15 +1,15 @@
 //! `projfluid run`: one scene, with progress, frames and a summary.
 
+use crate::frames::Frames;
 use crate::{Failure, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use projfluid::io::write_vtk;
 use projfluid::scene::Scene;
 use projfluid::stats::{RunAccumulator, RunSummary, StepStats};
 use projfluid::{Error, SolverKind, World};
 use std::fs::File;
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
@@ -43,7 +43,13 @@ pub(crate) struct RunArgs {
     /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Write a frame every N steps (and the initial state as frame 0).
+    /// Write PNG pictures (frame_00000.png, …) into this directory, created if missing.
+    #[arg(long, value_name = "DIR")]
+    png: Option<PathBuf>,
+    /// Width of the PNG pictures in pixels (the height is 9/16 of it).
+    #[arg(long, value_name = "PIXELS", default_value_t = 640)]
+    png_width: usize,
+    /// Write a frame (and picture) every N steps, and the initial state as frame 0.
     #[arg(long, value_name = "N")]
     every: Option<usize>,
     /// Write the run summary as JSON to this file.
@@ -77,13 +83,12 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         )),
         None => None,
     };
-    let mut frames = match &scene.output.dir {
-        Some(dir) => Some(Frames::new(dir, scene.output.every)?),
-        None => None,
-    };
-    if let Some(f) = frames.as_mut() {
-        f.write(&world)?;
-    }
+    let mut frames = Frames::new(
+        scene.output.dir.as_deref(),
+        args.png.as_deref().map(|dir| (dir, args.png_width)),
+        &world,
+    )?;
+    frames.write(&world)?;
     let goal = match target {
         Target::Time(d) => format!("{d} s simulated"),
         Target::Steps(n) => format!("{n} steps"),
@@ -117,10 +122,8 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
             .clone();
         let wall = clock.elapsed().as_secs_f64();
         acc.add(&stats, wall);
-        if let Some(f) = frames.as_mut() {
-            if acc.steps() % f.every as u64 == 0 {
-                f.write(&world)?;
-            }
+        if acc.steps() % scene.output.every as u64 == 0 {
+            frames.write(&world)?;
         }
         let done = match target {
             Target::Time(d) => (world.time() - start) / d,
@@ -172,6 +175,16 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure>
     if let Some(d) = args.duration {
         scene.duration = d;
     }
+    if !(16..=8192).contains(&args.png_width) {
+        return Err(Failure::Input(
+            Error::invalid(
+                "--png-width",
+                args.png_width,
+                "must lie in 16..=8192 pixels",
+            )
+            .to_string(),
+        ));
+    }
     if args.steps == Some(0) {
         return Err(Failure::Input(
             Error::invalid("--steps", 0, "must be at least 1").to_string(),
@@ -200,44 +213,6 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<Target, Failure>
         Some(n) => Target::Steps(n),
         None => Target::Time(scene.duration),
     })
-}
-
-/// Writes numbered VTK frames into a directory.
-struct Frames {
-    dir: PathBuf,
-    every: usize,
-    written: usize,
-}
-
-impl Frames {
-    /// Creates `dir` if needed.
-    fn new(dir: &Path, every: usize) -> Result<Self, Failure> {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Failure::Runtime(format!(
-                "cannot create output directory {}: {e}",
-                dir.display()
-            ))
-        })?;
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            every,
-            written: 0,
-        })
-    }
-
-    /// Writes the world's current state as the next frame.
-    fn write(&mut self, world: &World) -> Result<(), Failure> {
-        let path = self.dir.join(format!("frame_{:05}.vtk", self.written));
-        write_vtk(
-            &path,
-            &world.positions(),
-            &world.velocities(),
-            &world.densities(),
-        )
-        .map_err(|e| Failure::Runtime(e.to_string()))?;
-        self.written += 1;
-        Ok(())
-    }
 }
 
 /// Progress on stderr: a bar on a terminal, else a line about every 10 % of the run.

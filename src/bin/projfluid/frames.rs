@@ -1,0 +1,70 @@
+//! Numbered outputs of a run: data frames (VTK) and PNG pictures, written at the start and
+//! every N steps.
+
+use crate::Failure;
+use projfluid::World;
+use projfluid::io::render::Renderer;
+use projfluid::io::write_vtk;
+use std::path::{Path, PathBuf};
+
+/// Where frames and pictures go, and how many have been written.
+pub(crate) struct Frames {
+    data: Option<PathBuf>,
+    pictures: Option<(PathBuf, Renderer)>,
+    written: usize,
+}
+
+/// Creates `dir` if needed.
+fn create(dir: &Path) -> Result<PathBuf, Failure> {
+    std::fs::create_dir_all(dir).map_err(|e| {
+        Failure::Runtime(format!(
+            "cannot create output directory {}: {e}",
+            dir.display()
+        ))
+    })?;
+    Ok(dir.to_path_buf())
+}
+
+impl Frames {
+    /// Data frames into `data` and pictures `width` pixels wide into `pictures` (either may
+    /// be absent), with the camera framed on `world`'s containers; creates the directories.
+    pub(crate) fn new(
+        data: Option<&Path>,
+        pictures: Option<(&Path, usize)>,
+        world: &World,
+    ) -> Result<Self, Failure> {
+        Ok(Self {
+            data: data.map(create).transpose()?,
+            pictures: match pictures {
+                Some((dir, width)) => Some((
+                    create(dir)?,
+                    Renderer::for_world(world, width, (width * 9 / 16).max(1)),
+                )),
+                None => None,
+            },
+            written: 0,
+        })
+    }
+
+    /// Writes the world's current state as the next frame.
+    pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
+        let name = format!("frame_{:05}", self.written);
+        if let Some(dir) = &self.data {
+            write_vtk(
+                &dir.join(format!("{name}.vtk")),
+                &world.positions(),
+                &world.velocities(),
+                &world.densities(),
+            )
+            .map_err(|e| Failure::Runtime(e.to_string()))?;
+        }
+        if let Some((dir, renderer)) = &self.pictures {
+            renderer
+                .render_world(world)
+                .write_png(&dir.join(format!("{name}.png")))
+                .map_err(|e| Failure::Runtime(e.to_string()))?;
+        }
+        self.written += 1;
+        Ok(())
+    }
+}

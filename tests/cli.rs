@@ -306,3 +306,57 @@ fn png_pictures_are_written_at_the_frame_interval() {
     assert_bad_input(&out, &["--png-width", "3"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn ply_frames_hold_every_particle_with_velocity_and_density() {
+    let dir = temp_dir("ply");
+    let frames = dir.join("frames");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--every",
+        "2",
+        "--out",
+        frames.to_str().unwrap(),
+        "--format",
+        "ply",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(frames.join("frame_00001.ply")).unwrap();
+    assert!(!frames.join("frame_00001.vtk").exists());
+    let end = b"end_header\n";
+    let split = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+    let header = std::str::from_utf8(&bytes[..split]).unwrap();
+    let n = 16 * 20 * 12;
+    assert!(
+        header.contains(&format!("element vertex {n}\n")),
+        "{header}"
+    );
+    assert!(
+        header.contains("format binary_little_endian 1.0"),
+        "{header}"
+    );
+    assert_eq!(bytes.len() - split, n * 7 * 4);
+    let floats: Vec<f32> = bytes[split..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    // After two steps from rest everything falls (vy < 0); densities are about that of water
+    // (lower at the free surface and corners).
+    for record in floats.chunks_exact(7) {
+        assert!(
+            (0.0..2.1).contains(&record[0]) && record[4] < 0.0,
+            "{record:?}"
+        );
+        assert!((500.0..1100.0).contains(&record[6]), "{record:?}");
+    }
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--format", "obj"]);
+    assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}

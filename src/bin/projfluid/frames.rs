@@ -1,15 +1,24 @@
-//! Numbered outputs of a run: data frames (VTK) and PNG pictures, written at the start and
-//! every N steps.
+//! Numbered outputs of a run: data frames (VTK or PLY) and PNG pictures, written at the
+//! start and every N steps.
 
 use crate::Failure;
 use projfluid::World;
 use projfluid::io::render::Renderer;
-use projfluid::io::write_vtk;
+use projfluid::io::{write_ply, write_vtk};
 use std::path::{Path, PathBuf};
+
+/// File format of the data frames.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub(crate) enum FrameFormat {
+    /// Legacy VTK polydata (ParaView, VisIt).
+    Vtk,
+    /// Binary PLY point cloud (Blender, MeshLab).
+    Ply,
+}
 
 /// Where frames and pictures go, and how many have been written.
 pub(crate) struct Frames {
-    data: Option<PathBuf>,
+    data: Option<(PathBuf, FrameFormat)>,
     pictures: Option<(PathBuf, Renderer)>,
     written: usize,
 }
@@ -26,15 +35,16 @@ fn create(dir: &Path) -> Result<PathBuf, Failure> {
 }
 
 impl Frames {
-    /// Data frames into `data` and pictures `width` pixels wide into `pictures` (either may
+    /// Data frames into `data` in `format` and pictures `width` pixels wide into `pictures` (either may
     /// be absent), with the camera framed on `world`'s containers; creates the directories.
     pub(crate) fn new(
         data: Option<&Path>,
+        format: FrameFormat,
         pictures: Option<(&Path, usize)>,
         world: &World,
     ) -> Result<Self, Failure> {
         Ok(Self {
-            data: data.map(create).transpose()?,
+            data: data.map(|d| create(d).map(|d| (d, format))).transpose()?,
             pictures: match pictures {
                 Some((dir, width)) => Some((
                     create(dir)?,
@@ -49,9 +59,13 @@ impl Frames {
     /// Writes the world's current state as the next frame.
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
         let name = format!("frame_{:05}", self.written);
-        if let Some(dir) = &self.data {
-            write_vtk(
-                &dir.join(format!("{name}.vtk")),
+        if let Some((dir, format)) = &self.data {
+            let (write, extension): (fn(_, _, _, _) -> _, _) = match format {
+                FrameFormat::Vtk => (write_vtk, "vtk"),
+                FrameFormat::Ply => (write_ply, "ply"),
+            };
+            write(
+                &dir.join(format!("{name}.{extension}")),
                 &world.positions(),
                 &world.velocities(),
                 &world.densities(),

@@ -1,6 +1,6 @@
 //! `projfluid run`: one scene, with progress, frames and a summary.
 
-use crate::frames::Frames;
+use crate::frames::{FrameFormat, Frames};
 use crate::{Failure, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
@@ -40,9 +40,12 @@ pub(crate) struct RunArgs {
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N")]
     threads: Option<usize>,
-    /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
+    /// Write data frames (frame_00000.vtk or .ply, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// File format of the data frames: VTK (ParaView) or binary PLY (Blender, MeshLab).
+    #[arg(long, value_enum, default_value_t = FrameFormat::Vtk)]
+    format: FrameFormat,
     /// Write PNG pictures (frame_00000.png, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     png: Option<PathBuf>,
@@ -85,6 +88,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
     };
     let mut frames = Frames::new(
         scene.output.dir.as_deref(),
+        args.format,
         args.png.as_deref().map(|dir| (dir, args.png_width)),
         &world,
     )?;

@@ -360,3 +360,104 @@ fn ply_frames_hold_every_particle_with_velocity_and_density() {
     assert_eq!(out.status.code(), Some(2));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// The `positions_hash` of a `--stats` file.
+fn stats_hash(path: &Path) -> String {
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    json["positions_hash"].as_str().unwrap().to_string()
+}
+
+/// Runs projfluid with `args` plus `--stats FILE` and returns that file's positions hash.
+fn run_for_hash(dir: &Path, name: &str, args: &[&str]) -> String {
+    let stats = dir.join(format!("{name}.json"));
+    let mut all = args.to_vec();
+    all.extend(["--stats", stats.to_str().unwrap()]);
+    let out = projfluid(&all);
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stats_hash(&stats)
+}
+
+#[test]
+fn resumed_runs_equal_uninterrupted_runs_bit_for_bit() {
+    let dir = temp_dir("resume");
+    let ckpt = dir.join("ckpt");
+    let ckpt_dir = ckpt.to_str().unwrap();
+    for (label, length) in [
+        ("steps", ["--steps", "30"]),
+        ("time", ["--duration", "0.09"]),
+    ] {
+        let mut base = vec!["run", "dam_break_small"];
+        base.extend(length);
+        let whole = run_for_hash(&dir, &format!("{label}-whole"), &base);
+        let mut with_checkpoints = base.clone();
+        with_checkpoints.extend(["--checkpoint-every", "12", "--checkpoint-dir", ckpt_dir]);
+        let saved = run_for_hash(&dir, &format!("{label}-saved"), &with_checkpoints);
+        assert_eq!(saved, whole, "{label}: writing checkpoints changed the run");
+        let file = ckpt.join("checkpoint_000012.pfck");
+        if label == "steps" {
+            assert!(ckpt.join("checkpoint_000024.pfck").exists());
+        }
+        // Resumed on another thread count, the run goes on to the same end.
+        let resumed = run_for_hash(
+            &dir,
+            &format!("{label}-resumed"),
+            &["run", "--resume", file.to_str().unwrap(), "--threads", "1"],
+        );
+        assert_eq!(resumed, whole, "{label}: the resumed run differs");
+        std::fs::remove_dir_all(&ckpt).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn damaged_checkpoints_exit_2_with_a_clear_message() {
+    let dir = temp_dir("bad-checkpoint");
+    let ckpt = dir.join("ckpt");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--checkpoint-every",
+        "2",
+        "--checkpoint-dir",
+        ckpt.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let good = std::fs::read(ckpt.join("checkpoint_000002.pfck")).unwrap();
+    let bad = dir.join("bad.pfck");
+    let bad_str = bad.to_str().unwrap();
+    for (bytes, what) in [
+        (&good[..good.len() / 2], "damaged or truncated"),
+        (&good[..12], "truncated"),
+        (
+            &b"not a checkpoint at all"[..],
+            "not a projfluid checkpoint",
+        ),
+    ] {
+        std::fs::write(&bad, bytes).unwrap();
+        let out = projfluid(&["run", "--resume", bad_str]);
+        assert_bad_input(&out, &[bad_str, what]);
+    }
+    let out = projfluid(&["run", "--resume", dir.join("none.pfck").to_str().unwrap()]);
+    assert_bad_input(&out, &["cannot read checkpoint", "none.pfck"]);
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "1",
+        "--checkpoint-every",
+        "0",
+    ]);
+    assert_bad_input(&out, &["--checkpoint-every", "0"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -1,5 +1,6 @@
-//! Readers and writers: VTK and PLY frames, OBJ meshes, PNG pictures.
+//! Readers and writers: VTK and PLY frames, OBJ meshes, PNG pictures, checkpoints.
 
+pub mod checkpoint;
 pub mod obj;
 pub mod ply;
 pub mod render;

@@ -56,6 +56,12 @@ impl Frames {
         })
     }
 
+    /// Numbers the next frame `index + 1`, as when frames 0..=index were written by an
+    /// earlier run that this one continues.
+    pub(crate) fn continue_after(&mut self, index: u64) {
+        self.written = index as usize + 1;
+    }
+
     /// Writes the world's current state as the next frame.
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
         let name = format!("frame_{:05}", self.written);

@@ -4,6 +4,7 @@ use crate::frames::{FrameFormat, Frames};
 use crate::{Failure, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use projfluid::io::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
 use projfluid::scene::Scene;
 use projfluid::stats::{RunAccumulator, RunSummary, StepStats};
 use projfluid::{Error, SolverKind, World};
@@ -16,7 +17,18 @@ use std::time::Instant;
 #[derive(Args)]
 pub(crate) struct RunArgs {
     /// A built-in scene name (see `projfluid scenes`) or the path of a JSON scene file.
-    scene: String,
+    #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+    scene: Option<String>,
+    /// Continue the run saved in this checkpoint file, bit for bit, to the end it was going
+    /// to (or for --steps/--duration more).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "rho", "tau"])]
+    resume: Option<PathBuf>,
+    /// Write a checkpoint (checkpoint_NNNNNN.pfck, NNNNNN the step count) every N steps.
+    #[arg(long, value_name = "N")]
+    checkpoint_every: Option<u64>,
+    /// Directory for checkpoints, created if missing.
+    #[arg(long, value_name = "DIR", default_value = "checkpoints")]
+    checkpoint_dir: PathBuf,
     /// Simulated time to run, in seconds [default: the scene's duration].
     #[arg(
         long,
@@ -60,7 +72,7 @@ pub(crate) struct RunArgs {
     stats: Option<PathBuf>,
 }
 
-/// How long to run.
+/// How long to run, from the start of this invocation.
 #[derive(Clone, Copy)]
 enum Target {
     /// Simulated seconds.
@@ -71,11 +83,56 @@ enum Target {
 
 /// `projfluid run`.
 pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
-    let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
-    let target = apply_overrides(&mut scene, args)?;
-    let mut world = scene
-        .build_world()
-        .map_err(|e| Failure::Input(e.to_string()))?;
+    let (mut scene, mut world, saved_end) = match (&args.resume, &args.scene) {
+        (Some(path), _) => {
+            let c =
+                read_checkpoint(path, args.threads).map_err(|e| Failure::Input(e.to_string()))?;
+            (c.scene, c.world, c.run_end)
+        }
+        (None, Some(name)) => {
+            let scene = Scene::resolve(name).map_err(|e| Failure::Input(e.to_string()))?;
+            let world = scene
+                .build_world()
+                .map_err(|e| Failure::Input(e.to_string()))?;
+            (scene, world, None)
+        }
+        (None, None) => return Err(Failure::Input("a scene or --resume FILE is needed".into())),
+    };
+    let mut target = apply_overrides(&mut scene, args)?;
+    if args.resume.is_some() && args.steps.is_none() && args.duration.is_none() {
+        target = match saved_end {
+            Some(RunEnd::Steps(n)) => Target::Steps(n.saturating_sub(world.steps())),
+            Some(RunEnd::Time(t)) => Target::Time(t - world.time()),
+            None => {
+                return Err(Failure::Input(
+                    "the checkpoint does not say where its run ends; give --steps or --duration"
+                        .into(),
+                ));
+            }
+        };
+    }
+    // Where this run ends, in absolute terms (saved in checkpoints).
+    let (start_time, start_steps) = (world.time(), world.steps());
+    let run_end = match target {
+        Target::Time(d) => RunEnd::Time(match saved_end {
+            Some(RunEnd::Time(t)) if args.duration.is_none() && args.resume.is_some() => t,
+            _ => start_time + d,
+        }),
+        Target::Steps(n) => RunEnd::Steps(start_steps + n),
+    };
+    if args.checkpoint_every == Some(0) {
+        return Err(Failure::Input(
+            Error::invalid("--checkpoint-every", 0, "must be at least 1").to_string(),
+        ));
+    }
+    if args.checkpoint_every.is_some() {
+        std::fs::create_dir_all(&args.checkpoint_dir).map_err(|e| {
+            Failure::Runtime(format!(
+                "cannot create checkpoint directory {}: {e}",
+                args.checkpoint_dir.display()
+            ))
+        })?;
+    }
     // Open the stats file first, so that an unwritable path fails before a long run.
     let stats_file = match &args.stats {
         Some(path) => Some((
@@ -86,13 +143,19 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         )),
         None => None,
     };
+    let every = scene.output.every as u64;
     let mut frames = Frames::new(
         scene.output.dir.as_deref(),
         args.format,
         args.png.as_deref().map(|dir| (dir, args.png_width)),
         &world,
     )?;
-    frames.write(&world)?;
+    if args.resume.is_some() {
+        // Frame k holds step k·every; the frames up to now were written before.
+        frames.continue_after(world.steps() / every);
+    } else {
+        frames.write(&world)?;
+    }
     let goal = match target {
         Target::Time(d) => format!("{d} s simulated"),
         Target::Steps(n) => format!("{n} steps"),
@@ -106,18 +169,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
     );
     let mut acc = RunAccumulator::default();
     let mut progress = Progress::new(target);
-    let (start, end) = (world.time(), world.time() + scene.duration);
     loop {
-        let dt = match target {
-            Target::Time(_) => {
+        let dt = match run_end {
+            RunEnd::Time(end) => {
                 let left = end - world.time();
                 if left <= 1e-12 * end.abs().max(1.0) {
                     break;
                 }
                 world.next_dt().min(left)
             }
-            Target::Steps(n) if acc.steps() >= n => break,
-            Target::Steps(_) => world.next_dt(),
+            RunEnd::Steps(n) if world.steps() >= n => break,
+            RunEnd::Steps(_) => world.next_dt(),
         };
         let clock = Instant::now();
         let stats = world
@@ -126,12 +188,21 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
             .clone();
         let wall = clock.elapsed().as_secs_f64();
         acc.add(&stats, wall);
-        if acc.steps() % scene.output.every as u64 == 0 {
+        if world.steps() % every == 0 {
             frames.write(&world)?;
         }
-        let done = match target {
-            Target::Time(d) => (world.time() - start) / d,
-            Target::Steps(n) => acc.steps() as f64 / n as f64,
+        if let Some(n) = args.checkpoint_every {
+            if world.steps() % n == 0 {
+                let path = args
+                    .checkpoint_dir
+                    .join(format!("checkpoint_{:06}.pfck", world.steps()));
+                write_checkpoint(&path, &scene, &world, Some(run_end))
+                    .map_err(|e| Failure::Runtime(e.to_string()))?;
+            }
+        }
+        let done = match run_end {
+            RunEnd::Time(end) => (world.time() - start_time) / (end - start_time),
+            RunEnd::Steps(n) => (world.steps() - start_steps) as f64 / (n - start_steps) as f64,
         };
         progress.update(done, &world, &stats, wall);
     }

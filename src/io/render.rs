@@ -19,13 +19,20 @@ pub struct Camera {
 }
 
 impl Camera {
-    /// A camera in front of (+z), to the right of (+x) and above (+y) the box `bounds`,
-    /// looking at its centre from far enough that the whole box fits in an image of
-    /// aspect ratio `aspect` (width / height).
+    /// A camera above (+y) the box `bounds`, looking at its centre from as close as lets
+    /// the whole box fit in an image of aspect ratio `aspect` (width / height): in front of
+    /// (+z) and to the right of (+x) a box longer than deep, from the (+x, −z) corner along
+    /// the diagonal a box about as deep as long (whose x = z diagonal then runs across the
+    /// picture, so that things in opposite corners do not hide its middle).
     pub fn framing(bounds: &Aabb, aspect: f64) -> Camera {
         let fov_y_deg: f64 = 35.0;
         let centre = (bounds.min + bounds.max) * 0.5;
-        let back = Vec3::new(0.45, 0.55, 1.0).normalize();
+        let size = bounds.max - bounds.min;
+        let back = if size.z > 0.6 * size.x {
+            Vec3::new(1.0, 0.9, -1.0).normalize()
+        } else {
+            Vec3::new(0.45, 0.55, 1.0).normalize()
+        };
         let right = Vec3::y().cross(&back).normalize();
         let up = back.cross(&right);
         let tan_y = (fov_y_deg.to_radians() * 0.5).tan();
@@ -482,6 +489,38 @@ mod tests {
             let (x, y, _) = view.project(&corner).unwrap();
             assert!(x > 0.0 && x < r.width as f64 && y > 0.0 && y < r.height as f64);
         }
+    }
+
+    #[test]
+    fn square_tanks_are_seen_from_a_corner_and_fit() {
+        let bounds = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(8.0, 5.0, 8.0),
+        };
+        let r = Renderer {
+            camera: Camera::framing(&bounds, 16.0 / 9.0),
+            ..renderer()
+        };
+        let (eye, target) = (r.camera.eye, r.camera.target);
+        assert!(
+            eye.x > target.x && eye.z < target.z && eye.y > target.y,
+            "{eye:?}"
+        );
+        let view = View::new(&r);
+        let mut widest = 0.0f64;
+        for i in 0..8 {
+            let corner = Vec3::new(
+                if i & 1 == 0 { 0.0 } else { 8.0 },
+                if i & 2 == 0 { 0.0 } else { 5.0 },
+                if i & 4 == 0 { 0.0 } else { 8.0 },
+            );
+            let (x, y, _) = view.project(&corner).unwrap();
+            assert!(x > 0.0 && x < r.width as f64 && y > 0.0 && y < r.height as f64);
+            widest = widest.max((x - r.width as f64 / 2.0).abs() / (r.width as f64 / 2.0));
+            widest = widest.max((y - r.height as f64 / 2.0).abs() / (r.height as f64 / 2.0));
+        }
+        // Framed closely: some corner comes near the edge of the picture.
+        assert!(widest > 0.85, "{widest}");
     }
 
     #[test]

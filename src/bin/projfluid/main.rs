@@ -3,6 +3,9 @@
 //! ```text
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
+//!                     [--format vtk|ply] [--png DIR] [--png-width PIXELS]
+//!                     [--checkpoint-every N] [--checkpoint-dir DIR]
+//! projfluid run --resume FILE [--steps N | --duration SECONDS] [output options]
 //! projfluid scenes
 //! ```
 //!

@@ -140,6 +140,28 @@ typedef enum PfProjectionWeight {
 typedef struct PfWorld PfWorld;
 
 /**
+ * Where a mesh goes: every vertex p becomes `translate + R·(scale ∘ p)`, i.e. a per-axis
+ * scale about the origin, then a rotation, then a translation. The rotation is given as
+ * Euler angles in degrees about the fixed world axes, applied x first, then y, then z
+ * (R = R_z·R_y·R_x, right-handed). Fill it with `pf_transform_identity` and change what
+ * you need. Plain data owned by the caller.
+ */
+typedef struct PfTransform {
+    /**
+     * Scale factors along x, y and z (positive). Identity: 1, 1, 1.
+     */
+    double scale[3];
+    /**
+     * Rotation angles about the world x, y and z axes (degrees), applied in that order.
+     */
+    double rotate_deg[3];
+    /**
+     * Translation (m), applied last.
+     */
+    double translate[3];
+} PfTransform;
+
+/**
  * Every setting of a world (SI units: metres, seconds, kilograms). Fill it with
  * `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
  * validates it. The struct is plain data owned by the caller; the library copies it.
@@ -289,6 +311,79 @@ extern "C" {
 #endif // __cplusplus
 
 /**
+ * Writes the identity transform (scale 1, no rotation, no translation) to `*out`.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`.
+ *
+ * # Safety
+ * `out` must be NULL or point to a writable `PfTransform`.
+ */
+enum PfStatus pf_transform_identity(struct PfTransform *out);
+
+/**
+ * Adds a static obstacle given as a triangle mesh: `vertex_count` vertices `vertices`
+ * (3·vertex_count floats: x, y, z per vertex, metres) and `triangle_count` triangles
+ * `indices` (3·triangle_count zero-based vertex indices). The surface is sampled by
+ * Poisson disk with boundary particles about one particle radius r apart (no two closer
+ * than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
+ * always gives the same particles). Winding does not matter, and the mesh need not be
+ * closed or connected; only its surface is sampled. The mesh itself is not kept.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
+ * limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,
+ * named as `triangles[t][k]`, i.e. `indices[3·t + k]`; a degenerate triangle `triangles[t]`
+ * with a repeated index or collinear corners; a mesh far larger than r or needing too many
+ * particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `vertices` must be NULL or point to 3·vertex_count readable floats; `indices` must be NULL or point to 3·triangle_count readable `uint32_t`s.
+ */
+enum PfStatus pf_world_add_mesh(struct PfWorld *world,
+                                const float *vertices,
+                                size_t vertex_count,
+                                const uint32_t *indices,
+                                size_t triangle_count);
+
+/**
+ * Like `pf_world_add_mesh`, with the mesh first placed by `*transform` (see
+ * `PfTransform`; NULL means the identity). Transformed vertices are computed in double
+ * precision.
+ *
+ * Errors: those of `pf_world_add_mesh`, plus `PF_ERROR_INVALID_ARGUMENT` for a transform
+ * with a non-finite component or a scale factor that is not positive (named as
+ * `transform.scale` etc.), or one that makes a triangle degenerate. On any error no particle
+ * is added.
+ *
+ * # Safety
+ * As `pf_world_add_mesh`; `transform` must be NULL or point to a readable `PfTransform`.
+ */
+enum PfStatus pf_world_add_mesh_transformed(struct PfWorld *world,
+                                            const float *vertices,
+                                            size_t vertex_count,
+                                            const uint32_t *indices,
+                                            size_t triangle_count,
+                                            const struct PfTransform *transform);
+
+/**
+ * Adds a static obstacle read from the Wavefront OBJ file at `path` (a NUL-terminated
+ * UTF-8 path; coordinates in metres), placed by `*transform` (NULL means the identity) and
+ * sampled as in `pf_world_add_mesh`. Vertex positions and faces are used (polygons split
+ * into triangle fans); normals, texture coordinates, lines and materials are ignored.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or path), `PF_ERROR_INVALID_ARGUMENT`: a path that
+ * is not UTF-8, a file that cannot be read ("cannot read OBJ file PATH: …"), a file error
+ * naming the file and line ("PATH:LINE: malformed face …", "… face vertex index 9 is out of
+ * range …", "… face `f 1 2 2` is degenerate …"), a bad transform, or a mesh too large for
+ * the particle radius. On any error no particle is added.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `path` must be NULL or a NUL-terminated string; `transform` must be NULL or point to a readable `PfTransform`.
+ */
+enum PfStatus pf_world_add_obj(struct PfWorld *world,
+                               const char *path,
+                               const struct PfTransform *transform);
+
+/**
  * Fills `*out` with the default parameters (particle radius 0.025 m, water, Chebyshev
  * solver; see each field). Returns `PF_ERROR_NULL_POINTER` when `out` is NULL.
  *
@@ -417,30 +512,6 @@ enum PfStatus pf_world_add_fluid_box(struct PfWorld *world,
 enum PfStatus pf_world_add_boundary_particles(struct PfWorld *world,
                                               const float *xyz,
                                               size_t count);
-
-/**
- * Adds a static obstacle given as a triangle mesh: `vertex_count` vertices `vertices`
- * (3·vertex_count floats: x, y, z per vertex, metres) and `triangle_count` triangles
- * `indices` (3·triangle_count zero-based vertex indices). The surface is sampled by
- * Poisson disk with boundary particles about one particle radius r apart (no two closer
- * than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
- * always gives the same particles). Winding does not matter, and the mesh need not be
- * closed or connected; only its surface is sampled. The mesh itself is not kept.
- *
- * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
- * limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,
- * named as `triangles[t][k]`, i.e. `indices[3·t + k]`; a degenerate triangle `triangles[t]`
- * with a repeated index or collinear corners; a mesh far larger than r or needing too many
- * particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
- *
- * # Safety
- * `world` must be NULL or a live handle from `pf_world_create`; `vertices` must be NULL or point to 3·vertex_count readable floats; `indices` must be NULL or point to 3·triangle_count readable `uint32_t`s.
- */
-enum PfStatus pf_world_add_mesh(struct PfWorld *world,
-                                const float *vertices,
-                                size_t vertex_count,
-                                const uint32_t *indices,
-                                size_t triangle_count);
 
 /**
  * Adds a closed box container from corner `min` to corner `max` (3 floats each, metres):

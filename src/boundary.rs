@@ -7,6 +7,11 @@ use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use rayon::prelude::*;
 
 pub mod mesh;
+pub mod shapes;
+pub mod transform;
+pub mod winding;
+
+pub use transform::Transform;
 
 /// An axis-aligned box, corners in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]

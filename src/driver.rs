@@ -14,6 +14,11 @@ pub enum RunLength {
     Steps(u64),
     /// This much simulated time (s); the last step is shortened to land exactly.
     Duration(f64),
+    /// Until the world has taken this many steps in total (a resumed run's saved end).
+    UntilStep(u64),
+    /// Until the world's clock reads this time (s), the last step shortened to land exactly
+    /// (a resumed run's saved end).
+    UntilTime(f64),
 }
 
 /// What the driver tells its caller after every step.
@@ -79,7 +84,7 @@ pub fn run<E>(
     length: RunLength,
     mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
 ) -> Result<RunAccumulator, RunError<E>> {
-    if let RunLength::Duration(d) = length {
+    if let RunLength::Duration(d) | RunLength::UntilTime(d) = length {
         if !(d.is_finite() && d >= 0.0) {
             return Err(RunError::Step {
                 step: 1,
@@ -90,19 +95,24 @@ pub fn run<E>(
     let datum = energy_datum(world);
     let mut acc = RunAccumulator::default();
     acc.record_energy(total_energy(world, datum));
-    let start = world.time();
+    let (start, start_steps) = (world.time(), world.steps());
+    let until = |world: &World, end: f64| {
+        let left = end - world.time();
+        (left > 1e-12 * end.abs().max(1.0)).then(|| world.next_dt().min(left))
+    };
     loop {
         let dt = match length {
             RunLength::Steps(n) if acc.steps() >= n => break,
-            RunLength::Steps(_) => world.next_dt(),
-            RunLength::Duration(d) => {
-                let end = start + d;
-                let left = end - world.time();
-                if left <= 1e-12 * end.abs().max(1.0) {
-                    break;
-                }
-                world.next_dt().min(left)
-            }
+            RunLength::UntilStep(n) if world.steps() >= n => break,
+            RunLength::Steps(_) | RunLength::UntilStep(_) => world.next_dt(),
+            RunLength::Duration(d) => match until(world, start + d) {
+                Some(dt) => dt,
+                None => break,
+            },
+            RunLength::UntilTime(end) => match until(world, end) {
+                Some(dt) => dt,
+                None => break,
+            },
         };
         let (clock, cpu) = (Instant::now(), process_cpu_seconds());
         let stats = match world.step_with_dt(dt) {
@@ -121,8 +131,12 @@ pub fn run<E>(
         acc.record_energy(total_energy(world, datum));
         let done = match length {
             RunLength::Steps(n) => acc.steps() as f64 / n as f64,
+            RunLength::UntilStep(n) => {
+                (world.steps() - start_steps) as f64 / n.saturating_sub(start_steps).max(1) as f64
+            }
             RunLength::Duration(d) if d > 0.0 => (world.time() - start) / d,
-            RunLength::Duration(_) => 1.0,
+            RunLength::UntilTime(end) if end > start => (world.time() - start) / (end - start),
+            RunLength::Duration(_) | RunLength::UntilTime(_) => 1.0,
         };
         let report = StepReport {
             world,

@@ -36,6 +36,32 @@ impl UniformGrid {
             let largest = (0..3).max_by_key(|&a| dims[a]).unwrap_or(0);
             dims[largest] = dims[largest].div_ceil(2);
         }
+        Self::from_parts(origin, cell_size, dims)
+    }
+
+    /// The grid with lower corner `origin` (m), cells of edge `cell_size` (m) and `dims`
+    /// cells per axis (each at least 1, product at most the cell limit), e.g. as returned by
+    /// [`UniformGrid::parts`]; `None` for parts no grid has.
+    pub(crate) fn from_parts_checked(
+        origin: Vec3,
+        cell_size: f64,
+        dims: [usize; 3],
+    ) -> Option<Self> {
+        let valid = origin.iter().all(|c| c.is_finite())
+            && cell_size.is_finite()
+            && cell_size > 0.0
+            && dims.iter().all(|&d| (1..=1 << 20).contains(&d))
+            && dims.iter().product::<usize>() <= MAX_CELLS;
+        valid.then(|| Self::from_parts(origin, cell_size, dims))
+    }
+
+    /// Origin (m), cell size (m) and cells per axis: what [`UniformGrid::from_parts_checked`]
+    /// needs to rebuild this grid exactly.
+    pub(crate) fn parts(&self) -> (Vec3, f64, [usize; 3]) {
+        (self.origin, self.cell_size, self.dims)
+    }
+
+    fn from_parts(origin: Vec3, cell_size: f64, dims: [usize; 3]) -> Self {
         let count = dims.iter().product::<usize>();
         let mut by_morton: Vec<(u64, u32)> = (0..count)
             .map(|linear| {

@@ -457,7 +457,7 @@ impl World {
         }
     }
 
-    fn sort_boundary(&mut self) {
+    pub(crate) fn sort_boundary(&mut self) {
         let Some(grid) = &self.grid else { return };
         let b = &mut self.boundary;
         let mut order = Vec::new();

@@ -155,6 +155,16 @@ fn a_triangle_mesh_obstacle_becomes_boundary_particles_that_hold_the_fluid() {
 }
 
 #[test]
+fn obj_files_and_transformed_meshes_become_obstacles_and_bad_files_name_their_line() {
+    let dir = out_dir().join("obj-files");
+    std::fs::create_dir_all(&dir).unwrap();
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/obj.c", link), &[dir.to_str().unwrap()]);
+        assert!(out.starts_with("obj: ok"), "{link:?}: {out}");
+    }
+}
+
+#[test]
 fn distinct_worlds_step_in_parallel_and_one_world_reports_busy() {
     let out = run(&build("tests/c/parallel.c", Link::Shared), &["6"]);
     assert!(out.starts_with("parallel: ok"), "{out}");
@@ -271,10 +281,14 @@ fn c_tests_are_clean_under_valgrind() {
         return;
     }
     let suppressions = root().join("tests/c/valgrind.supp");
+    let obj_dir = out_dir().join("obj-files-valgrind");
+    std::fs::create_dir_all(&obj_dir).unwrap();
+    let obj_dir = obj_dir.to_string_lossy().into_owned();
     for (source, args) in [
         ("tests/c/basic.c", &["2"][..]),
         ("tests/c/misuse.c", &[][..]),
         ("tests/c/mesh.c", &["0.01"][..]),
+        ("tests/c/obj.c", &[obj_dir.as_str()][..]),
         ("tests/c/parallel.c", &["2"][..]),
     ] {
         let program = build(source, Link::Static);

@@ -483,3 +483,204 @@ fn tune_rho_writes_a_row_per_rho_and_names_the_choice() {
     assert_png(&dir.join("tune_rho_iterations.png"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+#[test]
+fn png_pictures_are_written_at_the_frame_interval() {
+    let dir = temp_dir("png");
+    let pictures = dir.join("pictures");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "4",
+        "--every",
+        "2",
+        "--png",
+        pictures.to_str().unwrap(),
+        "--png-width",
+        "160",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let mut names: Vec<String> = std::fs::read_dir(&pictures)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert_eq!(
+        names,
+        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+    );
+    let decoder = png::Decoder::new(std::fs::File::open(pictures.join("frame_00002.png")).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), (160, 90));
+    // The fluid is drawn: many pixels are bluish, unlike the grey background.
+    let blue = buf[..info.buffer_size()]
+        .chunks_exact(3)
+        .filter(|p| p[2] > 120 && p[2] > p[0] + 40)
+        .count();
+    assert!(blue > 100, "{blue} blue pixels");
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--png-width", "3"]);
+    assert_bad_input(&out, &["--png-width", "3"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn ply_frames_hold_every_particle_with_velocity_and_density() {
+    let dir = temp_dir("ply");
+    let frames = dir.join("frames");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--every",
+        "2",
+        "--out",
+        frames.to_str().unwrap(),
+        "--format",
+        "ply",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let bytes = std::fs::read(frames.join("frame_00001.ply")).unwrap();
+    assert!(!frames.join("frame_00001.vtk").exists());
+    let end = b"end_header\n";
+    let split = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+    let header = std::str::from_utf8(&bytes[..split]).unwrap();
+    let n = 16 * 20 * 12;
+    assert!(
+        header.contains(&format!("element vertex {n}\n")),
+        "{header}"
+    );
+    assert!(
+        header.contains("format binary_little_endian 1.0"),
+        "{header}"
+    );
+    assert_eq!(bytes.len() - split, n * 7 * 4);
+    let floats: Vec<f32> = bytes[split..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    // After two steps from rest everything falls (vy < 0); densities are about that of water
+    // (lower at the free surface and corners).
+    for record in floats.chunks_exact(7) {
+        assert!(
+            (0.0..2.1).contains(&record[0]) && record[4] < 0.0,
+            "{record:?}"
+        );
+        assert!((500.0..1100.0).contains(&record[6]), "{record:?}");
+    }
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--format", "obj"]);
+    assert_eq!(out.status.code(), Some(2));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The `positions_hash` of a `--stats` file.
+fn stats_hash(path: &Path) -> String {
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    json["positions_hash"].as_str().unwrap().to_string()
+}
+
+/// Runs projfluid with `args` plus `--stats FILE` and returns that file's positions hash.
+fn run_for_hash(dir: &Path, name: &str, args: &[&str]) -> String {
+    let stats = dir.join(format!("{name}.json"));
+    let mut all = args.to_vec();
+    all.extend(["--stats", stats.to_str().unwrap()]);
+    let out = projfluid(&all);
+    assert!(
+        out.status.success(),
+        "{name}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    stats_hash(&stats)
+}
+
+#[test]
+fn resumed_runs_equal_uninterrupted_runs_bit_for_bit() {
+    let dir = temp_dir("resume");
+    let ckpt = dir.join("ckpt");
+    let ckpt_dir = ckpt.to_str().unwrap();
+    for (label, length) in [
+        ("steps", ["--steps", "30"]),
+        ("time", ["--duration", "0.09"]),
+    ] {
+        let mut base = vec!["run", "dam_break_small"];
+        base.extend(length);
+        let whole = run_for_hash(&dir, &format!("{label}-whole"), &base);
+        let mut with_checkpoints = base.clone();
+        with_checkpoints.extend(["--checkpoint-every", "12", "--checkpoint-dir", ckpt_dir]);
+        let saved = run_for_hash(&dir, &format!("{label}-saved"), &with_checkpoints);
+        assert_eq!(saved, whole, "{label}: writing checkpoints changed the run");
+        let file = ckpt.join("checkpoint_000012.pfck");
+        if label == "steps" {
+            assert!(ckpt.join("checkpoint_000024.pfck").exists());
+        }
+        // Resumed on another thread count, the run goes on to the same end.
+        let resumed = run_for_hash(
+            &dir,
+            &format!("{label}-resumed"),
+            &["run", "--resume", file.to_str().unwrap(), "--threads", "1"],
+        );
+        assert_eq!(resumed, whole, "{label}: the resumed run differs");
+        std::fs::remove_dir_all(&ckpt).unwrap();
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+#[test]
+fn damaged_checkpoints_exit_2_with_a_clear_message() {
+    let dir = temp_dir("bad-checkpoint");
+    let ckpt = dir.join("ckpt");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--checkpoint-every",
+        "2",
+        "--checkpoint-dir",
+        ckpt.to_str().unwrap(),
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let good = std::fs::read(ckpt.join("checkpoint_000002.pfck")).unwrap();
+    let bad = dir.join("bad.pfck");
+    let bad_str = bad.to_str().unwrap();
+    for (bytes, what) in [
+        (&good[..good.len() / 2], "damaged or truncated"),
+        (&good[..12], "truncated"),
+        (
+            &b"not a checkpoint at all"[..],
+            "not a projfluid checkpoint",
+        ),
+    ] {
+        std::fs::write(&bad, bytes).unwrap();
+        let out = projfluid(&["run", "--resume", bad_str]);
+        assert_bad_input(&out, &[bad_str, what]);
+    }
+    let out = projfluid(&["run", "--resume", dir.join("none.pfck").to_str().unwrap()]);
+    assert_bad_input(&out, &["cannot read checkpoint", "none.pfck"]);
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "1",
+        "--checkpoint-every",
+        "0",
+    ]);
+    assert_bad_input(&out, &["--checkpoint-every", "0"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -560,6 +560,22 @@ mod tests {
     }
 
     #[test]
+    fn sculpture_samples_are_spaced_and_cover_its_curved_and_thin_parts() {
+        // The obstacle of the big scene, rotated and moved: curved tubes, a sphere, a fin
+        // 4 cm thick and ears 3 cm thick, with many triangles smaller than r.
+        let mesh = crate::scene::obstacle::generated("sculpture").unwrap();
+        let moved = crate::boundary::Transform {
+            rotate_deg: [0.0, 37.0, 0.0],
+            translate: [4.0, 0.0, 4.0],
+            ..Default::default()
+        }
+        .apply(&mesh)
+        .unwrap();
+        let samples = check_spacing_and_coverage(&moved);
+        assert!(samples.len() as f64 <= sample_count_bound(&moved, R));
+    }
+
+    #[test]
     fn sample_count_scales_with_area() {
         let small = sample_poisson_disk(&unit_cube(), R).len() as f64;
         let large = sample_poisson_disk(&box_mesh(Vec3::zeros(), Vec3::repeat(2.0)), R).len();

@@ -13,11 +13,13 @@
 //! - Thread safety: one world must not be used from two threads at once (a call that finds
 //!   the world busy returns `PF_ERROR_BUSY`); distinct worlds may be used in parallel.
 
+mod mesh;
 mod params;
 mod status;
 mod version;
 mod world;
 
+pub use mesh::*;
 pub use params::{PfOmega2Rule, PfParams, PfProjectionWeight, PfSolver};
 pub use params::{pf_params_default, pf_params_validate};
 pub use status::{PfStatus, pf_last_error_message, pf_status_name};

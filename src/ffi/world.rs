@@ -6,7 +6,6 @@ use super::status::{Failure, PfStatus, status_call};
 use super::{checked_mut_ptr, checked_ptr, input_slice, output_slice};
 use crate::Params;
 use crate::boundary::Aabb;
-use crate::boundary::mesh::TriangleMesh;
 use crate::{Vec3, World};
 use std::ffi::{c_char, c_uint};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
@@ -120,7 +119,7 @@ pub struct PfStepStats {
 ///
 /// # Safety
 /// `handle`, when non-NULL, must come from `pf_world_create` and not be destroyed.
-unsafe fn lock<'a>(handle: *const PfWorld) -> Result<MutexGuard<'a, World>, Failure> {
+pub(super) unsafe fn lock<'a>(handle: *const PfWorld) -> Result<MutexGuard<'a, World>, Failure> {
     let handle = checked_ptr(handle, "world")?;
     // SAFETY: a live handle from pf_world_create (the caller's promise); only shared access.
     let handle = unsafe { &*handle };
@@ -137,7 +136,7 @@ unsafe fn lock<'a>(handle: *const PfWorld) -> Result<MutexGuard<'a, World>, Fail
 }
 
 /// Checks a particle count: positive and at most the per-call limit.
-fn check_count(count: usize) -> Result<(), Failure> {
+pub(super) fn check_count(count: usize) -> Result<(), Failure> {
     if count == 0 {
         Err(Failure::invalid("count must be positive, got 0"))
     } else if count > MAX_PARTICLES_PER_CALL {
@@ -153,7 +152,11 @@ fn check_count(count: usize) -> Result<(), Failure> {
 ///
 /// # Safety
 /// `xyz`, when non-NULL, must point to `3·count` readable floats.
-unsafe fn read_vectors(xyz: *const f32, count: usize, what: &str) -> Result<Vec<Vec3>, Failure> {
+pub(super) unsafe fn read_vectors(
+    xyz: *const f32,
+    count: usize,
+    what: &str,
+) -> Result<Vec<Vec3>, Failure> {
     // SAFETY: forwarded from the caller; count ≤ MAX_PARTICLES_PER_CALL, so 3·count fits.
     let floats = unsafe { input_slice(xyz, 3 * count, what) }?;
     let mut out = Vec::new();
@@ -391,58 +394,6 @@ pub unsafe extern "C" fn pf_world_add_boundary_particles(
             .add_boundary_particles(&positions)
             .map_err(|e| renamed(e, "positions", "xyz"))
     })
-}
-
-/// Adds a static obstacle given as a triangle mesh: `vertex_count` vertices `vertices`
-/// (3·vertex_count floats: x, y, z per vertex, metres) and `triangle_count` triangles
-/// `indices` (3·triangle_count zero-based vertex indices). The surface is sampled by
-/// Poisson disk with boundary particles about one particle radius r apart (no two closer
-/// than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
-/// always gives the same particles). Winding does not matter, and the mesh need not be
-/// closed or connected; only its surface is sampled. The mesh itself is not kept.
-///
-/// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
-/// limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,
-/// named as `triangles[t][k]`, i.e. `indices[3·t + k]`; a degenerate triangle `triangles[t]`
-/// with a repeated index or collinear corners; a mesh far larger than r or needing too many
-/// particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
-///
-/// # Safety
-/// `world` must be NULL or a live handle from `pf_world_create`; `vertices` must be NULL or point to 3·vertex_count readable floats; `indices` must be NULL or point to 3·triangle_count readable `uint32_t`s.
-#[unsafe(no_mangle)]
-pub unsafe extern "C" fn pf_world_add_mesh(
-    world: *mut PfWorld,
-    vertices: *const f32,
-    vertex_count: usize,
-    indices: *const u32,
-    triangle_count: usize,
-) -> PfStatus {
-    status_call("pf_world_add_mesh", || {
-        // SAFETY: forwarded from the caller's promises.
-        let mut world = unsafe { lock(world) }?;
-        check_count(vertex_count).map_err(|f| named(f, "vertex_count"))?;
-        check_count(triangle_count).map_err(|f| named(f, "triangle_count"))?;
-        // SAFETY: as above; vertex_count ≤ MAX_PARTICLES_PER_CALL, so 3·vertex_count fits.
-        let positions = unsafe { read_vectors(vertices, vertex_count, "vertices") }?;
-        // SAFETY: as above; triangle_count ≤ MAX_PARTICLES_PER_CALL, so 3·triangle_count fits.
-        let flat = unsafe { input_slice(indices, 3 * triangle_count, "indices") }?;
-        let mut triangles = Vec::new();
-        triangles
-            .try_reserve_exact(triangle_count)
-            .map_err(|_| Failure::out_of_memory("indices"))?;
-        triangles.extend(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
-        let mesh = TriangleMesh::new(positions, triangles)?;
-        world.add_boundary_mesh(&mesh)?;
-        Ok(())
-    })
-}
-
-/// `failure` with its leading word `count` replaced by the argument name `name`.
-fn named(failure: Failure, name: &str) -> Failure {
-    match failure.message.strip_prefix("count") {
-        Some(rest) => Failure::new(failure.status, format!("{name}{rest}")),
-        None => failure,
-    }
 }
 
 /// Adds a closed box container from corner `min` to corner `max` (3 floats each, metres):

@@ -17,18 +17,7 @@ pub fn write_vtk(
     densities: &[f64],
 ) -> Result<(), Error> {
     let n = positions.len();
-    for (name, len) in [
-        ("velocities", velocities.len()),
-        ("densities", densities.len()),
-    ] {
-        if len != n {
-            return Err(Error::invalid(
-                name,
-                len,
-                &format!("must have one entry per position ({n})"),
-            ));
-        }
-    }
+    super::check_lengths(n, velocities, densities)?;
     if n > (i32::MAX / 2) as usize {
         return Err(Error::invalid(
             "positions",

@@ -1,10 +1,17 @@
 //! The built-in scenes (also shipped as `scenes/NAME.json`).
 
-use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
+use super::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};
+use crate::boundary::Transform;
 use crate::params::Params;
 
 /// Names of the built-in scenes, smallest first.
-pub(super) const NAMES: &[&str] = &["dam_break_small", "dam_break_30k"];
+pub(super) const NAMES: &[&str] = &[
+    "dam_break_small",
+    "dam_break_30k",
+    "dam_break_88k",
+    "double_dam_break_128k",
+    "obstacle_298k",
+];
 
 /// Particle radius of the built-in scenes (m).
 const RADIUS: f64 = 0.025;
@@ -26,7 +33,56 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             [5.00625, 3.00625, 1.30625],
             2.0,
         )),
+        "dam_break_88k" => Some(dam_break(
+            name,
+            "A 43x57x36 block of water (88,236 particles) collapses in a 7.2 x 4.3 x 1.85 m box: the 30k setup scaled by 1.43 with the same particle radius. Walls r/4 outside the nominal box.",
+            [43, 57, 36],
+            [7.20625, 4.30625, 1.85625],
+            2.0,
+        )),
+        "double_dam_break_128k" => Some(Scene {
+            fluid_blocks: vec![
+                block([0.05; 3], [32, 50, 40]),
+                block([6.4, 0.05, 0.05], [32, 50, 40]),
+            ],
+            ..dam_break(
+                name,
+                "Two 32x50x40 blocks of water (128,000 particles) at both ends of an 8 x 4 x 2.05 m box collapse and collide in the middle. Walls r/4 outside the nominal box.",
+                [1, 1, 1],
+                [8.00625, 4.00625, 2.05625],
+                2.0,
+            )
+        }),
+        "obstacle_298k" => Some(Scene {
+            fluid_blocks: vec![
+                block([0.05; 3], [53, 53, 53]),
+                block([5.35, 0.05, 5.35], [53, 53, 53]),
+            ],
+            obstacles: vec![ObstacleSpec {
+                mesh: MeshSource::Generated("sculpture".to_string()),
+                transform: Transform {
+                    translate: [4.0, 0.0, 4.0],
+                    ..Transform::default()
+                },
+            }],
+            ..dam_break(
+                name,
+                "Two 53x53x53 cubes of water (297,754 particles) in opposite corners of an 8 x 5 x 8 m tank collapse around a sculpture standing in the middle (the generated mesh `sculpture`: an arch-shaped body, a head, ears and a thin curled tail fin; also in scenes/obstacle.obj). Walls r/4 outside the nominal box.",
+                [1, 1, 1],
+                [8.00625, 5.00625, 8.00625],
+                3.0,
+            )
+        }),
         _ => None,
+    }
+}
+
+/// A block of fluid at rest with its first particle centre at `start` (m).
+fn block(start: [f64; 3], count: [usize; 3]) -> FluidBlock {
+    FluidBlock {
+        start,
+        count,
+        velocity: [0.0; 3],
     }
 }
 
@@ -53,11 +109,8 @@ fn dam_break(
             max,
             layers: 1,
         }],
-        fluid_blocks: vec![FluidBlock {
-            start: [0.05; 3],
-            count,
-            velocity: [0.0; 3],
-        }],
+        obstacles: Vec::new(),
+        fluid_blocks: vec![block([0.05; 3], count)],
         duration,
         output: OutputSpec::default(),
     }

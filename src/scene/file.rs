@@ -1,8 +1,9 @@
 //! The JSON form of a scene: serde structures mirroring the README ("Scene files"), their
 //! conversion to and from [`Scene`], and a printer that keeps number arrays on one line.
 
-use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
+use super::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};
 use crate::Error;
+use crate::boundary::Transform;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
 use serde::de::{MapAccess, SeqAccess, Visitor};
@@ -23,6 +24,8 @@ struct SceneFile {
     stiffness: Option<f64>,
     gravity: Option<[f64; 3]>,
     container: Option<Containers>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    obstacles: Option<Vec<ObstacleFile>>,
     fluid_blocks: Vec<FluidBlock>,
     solver: Option<SolverFile>,
     time: Option<TimeFile>,
@@ -63,6 +66,90 @@ struct TimeFile {
 struct OutputFile {
     dir: Option<String>,
     every: Option<usize>,
+}
+
+/// One entry of `obstacles`: a mesh source and its placement.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ObstacleFile {
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    obj: Option<String>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    generated: Option<String>,
+    scale: Option<Scale>,
+    rotate_deg: Option<[f64; 3]>,
+    translate: Option<[f64; 3]>,
+}
+
+/// `scale`: one factor for all axes, or one per axis.
+#[derive(Serialize, Deserialize, Clone, Copy)]
+#[serde(untagged)]
+enum Scale {
+    Uniform(f64),
+    PerAxis([f64; 3]),
+}
+
+impl ObstacleFile {
+    /// The obstacle, with a relative `obj` path taken relative to `base` (the scene file's
+    /// directory, if any). `i` names the entry in errors.
+    fn into_spec(self, i: usize, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
+        let mesh = match (self.obj, self.generated) {
+            (Some(obj), None) => {
+                let path = PathBuf::from(obj);
+                MeshSource::Obj(match base {
+                    Some(dir) if path.is_relative() => dir.join(path),
+                    _ => path,
+                })
+            }
+            (None, Some(name)) => MeshSource::Generated(name),
+            _ => {
+                return Err(Error::InvalidArgument {
+                    field: format!("obstacles[{i}]"),
+                    message: format!(
+                        "obstacles[{i}] needs exactly one mesh: `obj` (an OBJ file path) or \
+                         `generated` (one of {})",
+                        super::obstacle::NAMES.join(", ")
+                    ),
+                });
+            }
+        };
+        let identity = Transform::default();
+        Ok(ObstacleSpec {
+            mesh,
+            transform: Transform {
+                scale: match self.scale {
+                    None => identity.scale,
+                    Some(Scale::Uniform(s)) => [s; 3],
+                    Some(Scale::PerAxis(s)) => s,
+                },
+                rotate_deg: self.rotate_deg.unwrap_or(identity.rotate_deg),
+                translate: self.translate.unwrap_or(identity.translate),
+            },
+        })
+    }
+
+    /// Every key written out.
+    fn from_spec(spec: &ObstacleSpec) -> Self {
+        let t = &spec.transform;
+        let [x, y, z] = t.scale;
+        ObstacleFile {
+            obj: match &spec.mesh {
+                MeshSource::Obj(path) => Some(path.to_string_lossy().into_owned()),
+                MeshSource::Generated(_) => None,
+            },
+            generated: match &spec.mesh {
+                MeshSource::Generated(name) => Some(name.clone()),
+                MeshSource::Obj(_) => None,
+            },
+            scale: Some(if x == y && y == z {
+                Scale::Uniform(x)
+            } else {
+                Scale::PerAxis(t.scale)
+            }),
+            rotate_deg: Some(t.rotate_deg),
+            translate: Some(t.translate),
+        }
+    }
 }
 
 /// `solver.rho`: a number in [0, 1), or `"auto"` for the online estimate.
@@ -200,7 +287,8 @@ pub(super) fn parse(text: &str, origin: Option<&Path>, default_name: &str) -> Re
             json_error(e.into_inner(), &path, origin)
         })
         .and_then(|f| de.end().map(|()| f).map_err(|e| json_error(e, ".", origin)))?;
-    Ok(file.into_scene(default_name))
+    let base = origin.and_then(Path::parent);
+    file.into_scene(default_name, base)
 }
 
 /// A JSON error as "FILE: line L column C: PATH: MESSAGE".
@@ -244,8 +332,9 @@ fn json_error(e: serde_json::Error, path: &str, origin: Option<&Path>) -> Error 
 }
 
 impl SceneFile {
-    /// Fills in defaults from [`Params::with_radius`].
-    fn into_scene(self, default_name: &str) -> Scene {
+    /// Fills in defaults from [`Params::with_radius`]; relative obstacle paths are taken
+    /// relative to `base`.
+    fn into_scene(self, default_name: &str, base: Option<&Path>) -> Result<Scene, Error> {
         let mut p = Params::with_radius(self.particle_radius);
         let set = |slot: &mut f64, v: Option<f64>| *slot = v.unwrap_or(*slot);
         set(&mut p.rest_density, self.rest_density);
@@ -276,19 +365,27 @@ impl SceneFile {
         set(&mut p.dt_min, t.dt_min);
         set(&mut p.dt_max, t.dt_max);
         set(&mut p.dt_initial, t.dt_initial);
+        let obstacles = self
+            .obstacles
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+            .map(|(i, o)| o.into_spec(i, base))
+            .collect::<Result<_, _>>()?;
         let o = self.output.unwrap_or_default();
-        Scene {
+        Ok(Scene {
             name: self.name.unwrap_or_else(|| default_name.to_string()),
             description: self.description.unwrap_or_default(),
             params: p,
             containers: self.container.map(|c| c.0).unwrap_or_default(),
+            obstacles,
             fluid_blocks: self.fluid_blocks,
             duration: self.duration,
             output: OutputSpec {
                 dir: o.dir.map(PathBuf::from),
                 every: o.every.unwrap_or(super::DEFAULT_OUTPUT_EVERY),
             },
-        }
+        })
     }
 
     /// Every key written out.
@@ -304,6 +401,14 @@ impl SceneFile {
             stiffness: Some(p.stiffness),
             gravity: Some(p.gravity),
             container: Some(Containers(scene.containers.clone())),
+            obstacles: Some(
+                scene
+                    .obstacles
+                    .iter()
+                    .map(ObstacleFile::from_spec)
+                    .collect(),
+            )
+            .filter(|o: &Vec<ObstacleFile>| !o.is_empty()),
             fluid_blocks: scene.fluid_blocks.clone(),
             solver: Some(SolverFile {
                 kind: Some(p.solver),

@@ -37,6 +37,27 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
     for (i, c) in scene.containers.iter().enumerate() {
         check_container(i, c, r)?;
     }
+    for (i, o) in scene.obstacles.iter().enumerate() {
+        if let super::MeshSource::Generated(name) = &o.mesh {
+            if !super::obstacle::NAMES.contains(&name.as_str()) {
+                return Err(Error::invalid(
+                    format!("obstacles[{i}].generated"),
+                    format!("`{name}`"),
+                    &format!(
+                        "must name a generated mesh ({})",
+                        super::obstacle::NAMES.join(", ")
+                    ),
+                ));
+            }
+        }
+        o.transform.validate().map_err(|e| match e {
+            Error::InvalidArgument { field, message } => Error::InvalidArgument {
+                field: format!("obstacles[{i}].{field}"),
+                message: format!("obstacles[{i}].{message}"),
+            },
+            other => other,
+        })?;
+    }
     if scene.fluid_blocks.is_empty() {
         return Err(Error::invalid(
             "fluid_blocks",

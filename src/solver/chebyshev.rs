@@ -5,6 +5,7 @@
 use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 
 /// With `auto_rho`, every this many steps one step runs the plain iteration (a probe) to
 /// measure its contraction.
@@ -17,6 +18,17 @@ pub const AUTO_KAPPA: f64 = 0.9;
 pub const AUTO_SMOOTHING: f64 = 0.5;
 /// Range that the online ρ_c is clamped to.
 pub const AUTO_RHO_RANGE: (f64, f64) = (0.5, 0.95);
+
+/// The online ρ_c estimate carried from step to step (saved in checkpoints).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct OnlineRho {
+    /// ρ_c of the next step.
+    pub rho: f64,
+    /// Smoothed contraction ρ̂ of the probes so far.
+    pub contraction: Option<f64>,
+    /// Steps since the last probe.
+    pub since_probe: u64,
+}
 
 /// The ω recurrence of one time step, and the online ρ_c estimate carried across steps.
 #[derive(Clone, Debug)]
@@ -58,6 +70,23 @@ impl Chebyshev {
     /// True when the current step extrapolates (false during a probe).
     pub fn accelerates(&self) -> bool {
         !self.probing
+    }
+
+    /// The online estimate's state, to be saved with the world.
+    pub fn online(&self) -> OnlineRho {
+        OnlineRho {
+            rho: self.rho,
+            contraction: self.contraction,
+            since_probe: self.since_probe,
+        }
+    }
+
+    /// Restores a state saved by [`Chebyshev::online`].
+    pub fn set_online(&mut self, state: OnlineRho) {
+        self.rho = state.rho;
+        self.contraction = state.contraction;
+        self.since_probe = state.since_probe;
+        self.reset();
     }
 
     /// ρ_c that the current step extrapolates with.

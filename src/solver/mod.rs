@@ -7,7 +7,7 @@ mod jacobi;
 mod ldlt;
 
 pub use cg::Cg;
-pub use chebyshev::Chebyshev;
+pub use chebyshev::{Chebyshev, OnlineRho};
 pub use jacobi::Jacobi;
 pub use ldlt::Ldlt;
 

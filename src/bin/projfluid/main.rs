@@ -3,6 +3,9 @@
 //! ```text
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R|auto] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
+//!                     [--format vtk|ply] [--png DIR] [--png-width PIXELS]
+//!                     [--checkpoint-every N] [--checkpoint-dir DIR]
+//! projfluid run --resume FILE [--steps N | --duration SECONDS] [output options]
 //! projfluid scenes
 //! projfluid validate martin-moyce [--n2 2|1] [--resolution N] [--layers N] [--duration TAU]
 //!                                 [--solver S] [--threads N] [--out DIR]
@@ -18,6 +21,7 @@
 //! Each subcommand lives in its own module.
 
 mod bench;
+mod frames;
 mod run;
 mod tune_rho;
 mod validate;
@@ -45,7 +49,7 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Run a scene and print a summary of the run.
-    Run(run::RunArgs),
+    Run(Box<run::RunArgs>),
     /// List the built-in scenes.
     Scenes,
     /// Compare the solver with experiment and analytic solutions (writes CSV and PNG files).

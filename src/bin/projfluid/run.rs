@@ -1,22 +1,34 @@
 //! `projfluid run`: one scene, with progress, frames and a summary.
 
+use crate::frames::{FrameFormat, Frames};
 use crate::{Failure, RhoArg, rho_parser, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use projfluid::driver::{self, RunError, RunLength, StepReport};
-use projfluid::io::write_vtk;
+use projfluid::io::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
 use projfluid::scene::Scene;
 use projfluid::stats::RunSummary;
-use projfluid::{Error, SolverKind, World};
+use projfluid::{Error, SolverKind};
 use std::fs::File;
 use std::io::{IsTerminal, Write};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
 #[derive(Args)]
 pub(crate) struct RunArgs {
     /// A built-in scene name (see `projfluid scenes`) or the path of a JSON scene file.
-    scene: String,
+    #[arg(required_unless_present = "resume", conflicts_with = "resume")]
+    scene: Option<String>,
+    /// Continue the run saved in this checkpoint file, bit for bit, to the end it was going
+    /// to (or for --steps/--duration more).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "rho", "tau"])]
+    resume: Option<PathBuf>,
+    /// Write a checkpoint (checkpoint_NNNNNN.pfck, NNNNNN the step count) every N steps.
+    #[arg(long, value_name = "N")]
+    checkpoint_every: Option<u64>,
+    /// Directory for checkpoints, created if missing.
+    #[arg(long, value_name = "DIR", default_value = "checkpoints")]
+    checkpoint_dir: PathBuf,
     /// Simulated time to run, in seconds [default: the scene's duration].
     #[arg(
         long,
@@ -33,10 +45,19 @@ pub(crate) struct RunArgs {
     solver: Option<SolverKind>,
     #[command(flatten)]
     params: ParamOptions,
-    /// Write VTK frames (frame_00000.vtk, …) into this directory, created if missing.
+    /// Write data frames (frame_00000.vtk or .ply, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// Write a frame every N steps (and the initial state as frame 0).
+    /// File format of the data frames: VTK (ParaView) or binary PLY (Blender, MeshLab).
+    #[arg(long, value_enum, default_value_t = FrameFormat::Vtk)]
+    format: FrameFormat,
+    /// Write PNG pictures (frame_00000.png, …) into this directory, created if missing.
+    #[arg(long, value_name = "DIR")]
+    png: Option<PathBuf>,
+    /// Width of the PNG pictures in pixels (the height is 9/16 of it).
+    #[arg(long, value_name = "PIXELS", default_value_t = 640)]
+    png_width: usize,
+    /// Write a frame (and picture) every N steps, and the initial state as frame 0.
     #[arg(long, value_name = "N")]
     every: Option<usize>,
     /// Write the run summary as JSON to this file.
@@ -109,11 +130,59 @@ fn validate_naming_options(scene: &Scene, options: &[(&str, &str, bool)]) -> Res
 
 /// `projfluid run`.
 pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
-    let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
-    let target = apply_overrides(&mut scene, args)?;
-    let mut world = scene
-        .build_world()
-        .map_err(|e| Failure::Input(e.to_string()))?;
+    let (mut scene, mut world, saved_end) = match (&args.resume, &args.scene) {
+        (Some(path), _) => {
+            let c = read_checkpoint(path, args.params.threads)
+                .map_err(|e| Failure::Input(e.to_string()))?;
+            (c.scene, c.world, c.run_end)
+        }
+        (None, Some(name)) => {
+            let scene = Scene::resolve(name).map_err(|e| Failure::Input(e.to_string()))?;
+            let world = scene
+                .build_world()
+                .map_err(|e| Failure::Input(e.to_string()))?;
+            (scene, world, None)
+        }
+        (None, None) => return Err(Failure::Input("a scene or --resume FILE is needed".into())),
+    };
+    let mut target = apply_overrides(&mut scene, args)?;
+    if args.resume.is_some() && args.steps.is_none() && args.duration.is_none() {
+        target = match saved_end {
+            Some(RunEnd::Steps(n)) => RunLength::Steps(n.saturating_sub(world.steps())),
+            Some(RunEnd::Time(t)) => RunLength::Duration(t - world.time()),
+            None => {
+                return Err(Failure::Input(
+                    "the checkpoint does not say where its run ends; give --steps or --duration"
+                        .into(),
+                ));
+            }
+        };
+    }
+    // Where this run ends, in absolute terms (saved in checkpoints).
+    let (start_time, start_steps) = (world.time(), world.steps());
+    let run_end = match target {
+        RunLength::Duration(d) => RunEnd::Time(match saved_end {
+            Some(RunEnd::Time(t)) if args.duration.is_none() && args.resume.is_some() => t,
+            _ => start_time + d,
+        }),
+        RunLength::Steps(n) => RunEnd::Steps(start_steps + n),
+        RunLength::UntilStep(_) | RunLength::UntilTime(_) => {
+            unreachable!("apply_overrides gives a relative length")
+        }
+    };
+    if args.checkpoint_every == Some(0) {
+        return Err(Failure::Input(
+            Error::invalid("--checkpoint-every", 0, "must be at least 1").to_string(),
+        ));
+    }
+    if args.checkpoint_every.is_some() {
+        std::fs::create_dir_all(&args.checkpoint_dir).map_err(|e| {
+            Failure::Runtime(format!(
+                "cannot create checkpoint directory {}: {e}",
+                args.checkpoint_dir.display()
+            ))
+        })?;
+    }
     // Open the stats file first, so that an unwritable path fails before a long run.
     let stats_file = match &args.stats {
         Some(path) => Some((
@@ -124,16 +193,23 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         )),
         None => None,
     };
-    let mut frames = match &scene.output.dir {
-        Some(dir) => Some(Frames::new(dir, scene.output.every)?),
-        None => None,
-    };
-    if let Some(f) = frames.as_mut() {
-        f.write(&world)?;
+    let every = scene.output.every as u64;
+    let mut frames = Frames::new(
+        scene.output.dir.as_deref(),
+        args.format,
+        args.png.as_deref().map(|dir| (dir, args.png_width)),
+        &world,
+    )?;
+    if args.resume.is_some() {
+        // Frame k holds step k·every; the frames up to now were written before.
+        frames.continue_after(world.steps() / every);
+    } else {
+        frames.write(&world)?;
     }
     let goal = match target {
         RunLength::Duration(d) => format!("{d} s simulated"),
         RunLength::Steps(n) => format!("{n} steps"),
+        RunLength::UntilStep(_) | RunLength::UntilTime(_) => String::new(),
     };
     eprintln!(
         "{}: {} particles, {} boundary particles, {} solver, {goal}",
@@ -143,10 +219,22 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         scene.params.solver.name()
     );
     let mut progress = Progress::new(target);
-    let acc = driver::run(&mut world, target, |report| {
-        if let Some(f) = frames.as_mut() {
-            if report.steps % f.every as u64 == 0 {
-                f.write(report.world)?;
+    let length = match run_end {
+        RunEnd::Time(end) => RunLength::UntilTime(end),
+        RunEnd::Steps(n) => RunLength::UntilStep(n),
+    };
+    let acc = driver::run(&mut world, length, |report| {
+        let world = report.world;
+        if world.steps() % every == 0 {
+            frames.write(world)?;
+        }
+        if let Some(n) = args.checkpoint_every {
+            if world.steps() % n == 0 {
+                let path = args
+                    .checkpoint_dir
+                    .join(format!("checkpoint_{:06}.pfck", world.steps()));
+                write_checkpoint(&path, &scene, world, Some(run_end))
+                    .map_err(|e| Failure::Runtime(e.to_string()))?;
             }
         }
         progress.update(report);
@@ -191,6 +279,16 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
     if let Some(d) = args.duration {
         scene.duration = d;
     }
+    if !(16..=8192).contains(&args.png_width) {
+        return Err(Failure::Input(
+            Error::invalid(
+                "--png-width",
+                args.png_width,
+                "must lie in 16..=8192 pixels",
+            )
+            .to_string(),
+        ));
+    }
     if args.steps == Some(0) {
         return Err(Failure::Input(
             Error::invalid("--steps", 0, "must be at least 1").to_string(),
@@ -206,44 +304,6 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
         Some(n) => RunLength::Steps(n),
         None => RunLength::Duration(scene.duration),
     })
-}
-
-/// Writes numbered VTK frames into a directory.
-struct Frames {
-    dir: PathBuf,
-    every: usize,
-    written: usize,
-}
-
-impl Frames {
-    /// Creates `dir` if needed.
-    fn new(dir: &Path, every: usize) -> Result<Self, Failure> {
-        std::fs::create_dir_all(dir).map_err(|e| {
-            Failure::Runtime(format!(
-                "cannot create output directory {}: {e}",
-                dir.display()
-            ))
-        })?;
-        Ok(Self {
-            dir: dir.to_path_buf(),
-            every,
-            written: 0,
-        })
-    }
-
-    /// Writes the world's current state as the next frame.
-    fn write(&mut self, world: &World) -> Result<(), Failure> {
-        let path = self.dir.join(format!("frame_{:05}.vtk", self.written));
-        write_vtk(
-            &path,
-            &world.positions(),
-            &world.velocities(),
-            &world.densities(),
-        )
-        .map_err(|e| Failure::Runtime(e.to_string()))?;
-        self.written += 1;
-        Ok(())
-    }
 }
 
 /// Progress on stderr: a bar on a terminal, else a line about every 10 % of the run.

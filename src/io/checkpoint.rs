@@ -1,0 +1,396 @@
+//! Checkpoints: the complete state of a run in one file, so that a resumed run continues
+//! bit for bit as if it had never stopped.
+//!
+//! Besides positions, velocities and time, the step depends on the storage order of the
+//! particles (the counting sort is stable, and the order decides the order of floating-point
+//! sums), on the neighbour grid (its origin decides the cells, hence the sort) and on the
+//! boundary particles in their sorted order. All of these are stored as they are.
+//!
+//! Layout: the magic `PFCHECK1`; the length (u64, little-endian) of a JSON header, the
+//! header (the scene with the world's parameters, time, step count, next Δt, containers,
+//! grid, counts, the run's end, the online ρ_c estimate); the fluid positions, velocities and densities as f64
+//! triples/values, the particle ids as u32, the boundary positions as f64 triples (all
+//! little-endian); and a SHA-256 digest of everything before it, so that a damaged or
+//! truncated file is refused.
+
+use crate::boundary::Aabb;
+use crate::neighbors::UniformGrid;
+use crate::scene::Scene;
+use crate::solver::OnlineRho;
+use crate::{Error, Vec3, World};
+use serde::{Deserialize, Serialize};
+use sha2::{Digest, Sha256};
+use std::path::Path;
+
+const MAGIC: &[u8; 8] = b"PFCHECK1";
+const DIGEST_LEN: usize = 32;
+
+/// Where the interrupted run was going to stop.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum RunEnd {
+    /// At this simulated time (s).
+    Time(f64),
+    /// After this many steps in all.
+    Steps(u64),
+}
+
+/// A restored run: the scene it came from (with the world's parameters), the world in the
+/// exact state it was saved in, and where the run was going to stop.
+pub struct Checkpoint {
+    /// The scene, its parameters those of the saved world.
+    pub scene: Scene,
+    /// The world, ready to continue.
+    pub world: World,
+    /// The end of the interrupted run, if it was saved.
+    pub run_end: Option<RunEnd>,
+}
+
+/// The JSON header.
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct Header {
+    scene: String,
+    time: f64,
+    steps: u64,
+    next_dt: f64,
+    containers: Vec<[[f64; 3]; 2]>,
+    grid: Option<GridParts>,
+    grid_capped: bool,
+    boundary_dirty: bool,
+    fluid_count: usize,
+    boundary_count: usize,
+    run_end: Option<RunEnd>,
+    chebyshev: OnlineRho,
+}
+
+/// The neighbour grid, as [`UniformGrid::parts`].
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct GridParts {
+    origin: [f64; 3],
+    cell_size: f64,
+    dims: [usize; 3],
+}
+
+/// Writes a checkpoint of `world`, which was built from `scene`, to `path` (through a
+/// temporary file renamed into place, so that an interrupted write never leaves a partial
+/// checkpoint under that name). `run_end` records where the run was going to stop.
+pub fn write_checkpoint(
+    path: &Path,
+    scene: &Scene,
+    world: &World,
+    run_end: Option<RunEnd>,
+) -> Result<(), Error> {
+    let mut scene = scene.clone();
+    scene.params = world.params.clone();
+    let header = Header {
+        scene: scene.to_json(),
+        time: world.time,
+        steps: world.steps,
+        next_dt: world.next_dt,
+        containers: world
+            .containers
+            .iter()
+            .map(|c| [c.min.into(), c.max.into()])
+            .collect(),
+        grid: world.grid.as_ref().map(|g| {
+            let (origin, cell_size, dims) = g.parts();
+            GridParts {
+                origin: origin.into(),
+                cell_size,
+                dims,
+            }
+        }),
+        grid_capped: world.grid_capped,
+        boundary_dirty: world.boundary.dirty,
+        fluid_count: world.fluid.positions.len(),
+        boundary_count: world.boundary.positions.len(),
+        run_end,
+        chebyshev: world.chebyshev.online(),
+    };
+    let json = serde_json::to_vec(&header)
+        .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
+    let f = &world.fluid;
+    let mut bytes = Vec::with_capacity(
+        64 + json.len() + f.positions.len() * 60 + world.boundary.positions.len() * 24,
+    );
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&json);
+    for v in f.positions.iter().chain(&f.velocities) {
+        push_vec3(&mut bytes, v);
+    }
+    for d in &f.densities {
+        bytes.extend_from_slice(&d.to_le_bytes());
+    }
+    for id in &f.ids {
+        bytes.extend_from_slice(&id.to_le_bytes());
+    }
+    for p in &world.boundary.positions {
+        push_vec3(&mut bytes, p);
+    }
+    let digest = Sha256::digest(&bytes);
+    bytes.extend_from_slice(&digest);
+
+    let fail =
+        |e: std::io::Error| Error::Io(format!("cannot write checkpoint {}: {e}", path.display()));
+    let mut temporary = path.as_os_str().to_owned();
+    temporary.push(".partial");
+    std::fs::write(&temporary, &bytes).map_err(fail)?;
+    std::fs::rename(&temporary, path).map_err(fail)
+}
+
+fn push_vec3(bytes: &mut Vec<u8>, v: &Vec3) {
+    for c in v.iter() {
+        bytes.extend_from_slice(&c.to_le_bytes());
+    }
+}
+
+/// Reads the checkpoint at `path` and rebuilds its world, on `threads` worker threads when
+/// given (the result does not depend on it), else on the saved parameters' count. Errors
+/// ([`Error::InvalidArgument`] with field `checkpoint`, or [`Error::Io`] when unreadable)
+/// start with the path and say what is wrong: not a checkpoint, truncated, damaged
+/// (digest mismatch) or inconsistent.
+pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint, Error> {
+    let bytes = std::fs::read(path)
+        .map_err(|e| Error::Io(format!("cannot read checkpoint {}: {e}", path.display())))?;
+    let bad = |what: &str| Error::InvalidArgument {
+        field: "checkpoint".to_string(),
+        message: format!("{}: {what}", path.display()),
+    };
+    if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+        return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
+    }
+    if bytes.len() < MAGIC.len() + 8 + DIGEST_LEN {
+        return Err(bad("is truncated"));
+    }
+    let (body, digest) = bytes.split_at(bytes.len() - DIGEST_LEN);
+    let header_len = u64::from_le_bytes(body[8..16].try_into().unwrap_or_default());
+    let header_end = usize::try_from(header_len)
+        .ok()
+        .and_then(|n| n.checked_add(16))
+        .filter(|&end| end <= body.len());
+    let Some(header_end) = header_end else {
+        return Err(bad(
+            "is truncated (the header runs past the end of the file)",
+        ));
+    };
+    if Sha256::digest(body).as_slice() != digest {
+        return Err(bad(
+            "is damaged or truncated (its SHA-256 digest does not match its contents)",
+        ));
+    }
+    let header: Header = serde_json::from_slice(&body[16..header_end])
+        .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
+    let (n, m) = (header.fluid_count, header.boundary_count);
+    let expected = n
+        .checked_mul(3 * 8 * 2 + 8 + 4)
+        .and_then(|f| m.checked_mul(24).and_then(|b| f.checked_add(b)));
+    if expected != Some(body.len() - header_end) {
+        return Err(bad(&format!(
+            "holds {} bytes of particle data, not the {n} fluid and {m} boundary particles its header announces",
+            body.len() - header_end
+        )));
+    }
+    let mut scene = Scene::from_json(&header.scene)
+        .map_err(|e| bad(&format!("holds an invalid scene: {e}")))?;
+    if let Some(t) = threads {
+        scene.params.threads = t;
+    }
+
+    let mut data = Reader(&body[header_end..]);
+    let positions = data.vec3s(n);
+    let velocities = data.vec3s(n);
+    let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
+    let ids: Vec<u32> = (0..n).map(|_| u32::from_le_bytes(data.take())).collect();
+    let boundary = data.vec3s(m);
+    let mut seen = vec![false; n];
+    for &id in &ids {
+        match seen.get_mut(id as usize) {
+            Some(s) if !*s => *s = true,
+            _ => return Err(bad("is inconsistent: the particle ids are not 0..n")),
+        }
+    }
+
+    let mut world = World::new(scene.params.clone())?;
+    world.add_fluid_particles(&positions, Some(&velocities))?;
+    world.add_boundary_particles(&boundary)?;
+    world.fluid.densities = densities;
+    world.fluid.ids = ids;
+    world.containers = header
+        .containers
+        .iter()
+        .map(|[min, max]| Aabb {
+            min: Vec3::from(*min),
+            max: Vec3::from(*max),
+        })
+        .collect();
+    world.time = header.time;
+    world.steps = header.steps;
+    world.next_dt = header.next_dt;
+    world.chebyshev.set_online(header.chebyshev);
+    world.grid_capped = header.grid_capped;
+    world.grid = match header.grid {
+        None => None,
+        Some(g) => Some(
+            UniformGrid::from_parts_checked(Vec3::from(g.origin), g.cell_size, g.dims)
+                .ok_or_else(|| bad("is inconsistent: its neighbour grid is invalid"))?,
+        ),
+    };
+    // The boundary was saved in its sorted order: sorting again keeps that order and
+    // recomputes the same volumes.
+    world.boundary.dirty = header.boundary_dirty || world.grid.is_none();
+    if !world.boundary.dirty {
+        world.sort_boundary();
+    }
+    Ok(Checkpoint {
+        scene,
+        world,
+        run_end: header.run_end,
+    })
+}
+
+/// Little-endian values read from the front of a slice whose length was checked.
+struct Reader<'a>(&'a [u8]);
+
+impl Reader<'_> {
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let (head, rest) = self.0.split_at(N);
+        self.0 = rest;
+        head.try_into().unwrap_or([0; N])
+    }
+
+    fn vec3s(&mut self, count: usize) -> Vec<Vec3> {
+        (0..count)
+            .map(|_| {
+                Vec3::from(std::array::from_fn::<f64, 3, _>(|_| {
+                    f64::from_le_bytes(self.take())
+                }))
+            })
+            .collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn temp(name: &str) -> std::path::PathBuf {
+        std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
+    }
+
+    fn small_scene() -> Scene {
+        let mut scene = Scene::builtin("dam_break_small").unwrap();
+        scene.fluid_blocks[0].count = [6, 8, 5];
+        scene
+    }
+
+    #[test]
+    fn a_resumed_world_continues_bit_for_bit() {
+        let scene = small_scene();
+        let mut reference = scene.build_world().unwrap();
+        let mut interrupted = scene.build_world().unwrap();
+        for _ in 0..15 {
+            reference.step().unwrap();
+            interrupted.step().unwrap();
+        }
+        let path = temp("resume.pfck");
+        write_checkpoint(&path, &scene, &interrupted, Some(RunEnd::Steps(30))).unwrap();
+        drop(interrupted);
+        let restored = read_checkpoint(&path, Some(3)).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(restored.run_end, Some(RunEnd::Steps(30)));
+        assert_eq!(restored.world.thread_count(), 3);
+        let mut resumed = restored.world;
+        assert_eq!(resumed.positions_hash(), reference.positions_hash());
+        assert_eq!(resumed.boundary_positions(), reference.boundary_positions());
+        assert_eq!(resumed.boundary.psi, reference.boundary.psi);
+        for _ in 0..15 {
+            reference.step().unwrap();
+            resumed.step().unwrap();
+        }
+        assert_eq!(resumed.steps(), 30);
+        assert_eq!(resumed.time().to_bits(), reference.time().to_bits());
+        assert_eq!(resumed.next_dt().to_bits(), reference.next_dt().to_bits());
+        assert_eq!(resumed.positions_hash(), reference.positions_hash());
+        assert!(resumed.velocities() == reference.velocities());
+    }
+
+    /// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
+    /// one that forgot the estimate does not.
+    #[test]
+    fn a_resumed_world_keeps_its_online_rho() {
+        let mut scene = small_scene();
+        scene.params.chebyshev.auto_rho = true;
+        // A tight τ makes the probes long enough to measure.
+        scene.params.displacement_tolerance = 1e-4 * scene.params.particle_radius;
+        let mut reference = scene.build_world().unwrap();
+        for _ in 0..50 {
+            reference.step().unwrap();
+        }
+        let saved = reference.chebyshev.online();
+        assert!(
+            saved.contraction.is_some() && saved.since_probe > 0,
+            "{saved:?}"
+        );
+        let path = temp("online-rho.pfck");
+        write_checkpoint(&path, &scene, &reference, None).unwrap();
+        let mut resumed = read_checkpoint(&path, None).unwrap().world;
+        let mut forgetful = read_checkpoint(&path, None).unwrap().world;
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(resumed.chebyshev.online(), saved);
+        forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
+        for _ in 0..30 {
+            reference.step().unwrap();
+            resumed.step().unwrap();
+            forgetful.step().unwrap();
+        }
+        assert_eq!(resumed.positions_hash(), reference.positions_hash());
+        assert_ne!(forgetful.positions_hash(), reference.positions_hash());
+    }
+
+    #[test]
+    fn a_checkpoint_before_the_first_step_resumes_too() {
+        let scene = small_scene();
+        let mut reference = scene.build_world().unwrap();
+        let path = temp("fresh.pfck");
+        write_checkpoint(&path, &scene, &reference, None).unwrap();
+        let mut resumed = read_checkpoint(&path, None).unwrap().world;
+        std::fs::remove_file(&path).unwrap();
+        for _ in 0..5 {
+            reference.step().unwrap();
+            resumed.step().unwrap();
+        }
+        assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    }
+
+    #[test]
+    fn damaged_truncated_and_foreign_files_are_refused() {
+        let scene = small_scene();
+        let mut world = scene.build_world().unwrap();
+        world.step().unwrap();
+        let path = temp("damaged.pfck");
+        write_checkpoint(&path, &scene, &world, None).unwrap();
+        let good = std::fs::read(&path).unwrap();
+        let message = |bytes: &[u8]| {
+            std::fs::write(&path, bytes).unwrap();
+            match read_checkpoint(&path, None) {
+                Ok(_) => panic!("a bad checkpoint was accepted"),
+                Err(e) => e.to_string(),
+            }
+        };
+        let mut flipped = good.clone();
+        flipped[good.len() / 2] ^= 1;
+        let msg = message(&flipped);
+        assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+        assert!(msg.contains("damaged or truncated"), "{msg}");
+        assert!(message(&good[..good.len() - 100]).contains("damaged or truncated"));
+        assert!(message(&good[..20]).contains("truncated"));
+        assert!(message(b"{\"name\": 1}").contains("not a projfluid checkpoint"));
+        assert!(message(&[]).contains("not a projfluid checkpoint"));
+        std::fs::remove_file(&path).unwrap();
+        let msg = read_checkpoint(&path, None).err().unwrap().to_string();
+        assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
+    }
+}

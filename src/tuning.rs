@@ -188,6 +188,9 @@ pub struct TuneReport {
     /// Index into `trials` of the chosen value: the smallest ρ reachable from the minimiser
     /// through eligible neighbours whose cost is within [`COST_TOLERANCE`] of the minimum.
     pub best: Option<usize>,
+    /// Chebyshev with ρ estimated online (`auto_rho`) from the same state, for comparison;
+    /// its `rho` is the mean online estimate.
+    pub auto: Trial,
 }
 
 impl TuneReport {
@@ -206,6 +209,8 @@ pub enum Phase {
     Plain,
     /// The run with this ρ.
     Rho(f64),
+    /// The run with ρ estimated online.
+    Auto,
 }
 
 /// Runs the whole procedure of ALGORITHM.md §5.2 on `scene` (its parameters as given, e.g.
@@ -268,8 +273,22 @@ pub fn tune_rho(
             rejection,
         });
     }
+    on_phase(Phase::Auto);
+    let mut world = snapshot(scene, config.warmup_steps)?;
+    let online = crate::ChebyshevParams {
+        auto_rho: true,
+        ..scene.params.chebyshev
+    };
+    world.set_solver(SolverKind::Chebyshev, online)?;
+    let summary = driver::run_quietly(&mut world, length)?.summary(&scene.name, &world);
+    let auto = Trial {
+        rho: summary.rho,
+        rejection: judge(&summary, &plain),
+        summary,
+    };
     let (minimiser, best) = pick(&trials);
     Ok(TuneReport {
+        auto,
         config: config.clone(),
         estimate: median(&step_estimates),
         step_estimates,

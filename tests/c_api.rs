@@ -98,6 +98,10 @@ fn build(source: &str, link: Link) -> PathBuf {
             cc.arg("-L")
                 .arg(&libs)
                 .arg("-lprojfluid")
+                // RPATH rather than RUNPATH: cargo test puts target/<profile> (which may hold
+                // an older libprojfluid.so from `cargo build`) on LD_LIBRARY_PATH, and only an
+                // RPATH takes precedence over it.
+                .arg("-Wl,--disable-new-dtags")
                 .arg(format!("-Wl,-rpath,{}", libs.display()))
                 .args(["-lm", "-lpthread"]);
         }

@@ -263,7 +263,8 @@ fn scenes_lists_builtins_with_particle_counts() {
 }
 
 /// `--rho auto` estimates ρ_c online: the summary and the stats say so and report the mean
-/// estimate, which lies in the clamped range rather than at the starting value.
+/// estimate, which lies in the clamped range rather than at the starting value. Options given
+/// with it reach the world (`--threads 1` on any machine).
 #[test]
 fn rho_auto_runs_and_reports_its_estimate() {
     let dir = temp_dir("rho-auto");
@@ -275,6 +276,11 @@ fn rho_auto_runs_and_reports_its_estimate() {
         "60",
         "--rho",
         "auto",
+        "--threads",
+        "1",
+        // A tight τ makes the probes long enough to measure the contraction.
+        "--tau",
+        "2.5e-6",
         "--stats",
         stats.to_str().unwrap(),
     ]);
@@ -283,6 +289,8 @@ fn rho_auto_runs_and_reports_its_estimate() {
     let json: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert_eq!(json["rho_auto"], true);
+    // The options reach the world that runs.
+    assert_eq!(json["threads"], 1);
     let rho = json["rho"].as_f64().unwrap();
     assert!((0.5..=0.95).contains(&rho) && rho != 0.85, "mean rho {rho}");
 }
@@ -469,13 +477,14 @@ fn tune_rho_writes_a_row_per_rho_and_names_the_choice() {
         String::from_utf8_lossy(&out.stderr)
     );
     assert!(stdout.contains("best rho: "), "{stdout}");
+    assert!(stdout.contains("rho auto: "), "{stdout}");
     assert_eq!(
         std::fs::read_to_string(dir.join("tune_rho.md")).unwrap(),
         stdout
     );
     let (header, rows) = read_csv(&dir.join("tune_rho.csv"));
     let labels: Vec<&str> = rows.iter().map(|r| r[0].as_str()).collect();
-    assert_eq!(labels, ["plain", "0.8", "0.9"]);
+    assert_eq!(labels, ["plain", "0.8", "0.9", "auto"]);
     for row in &rows {
         assert!(number(&header, row, "outer_iterations_mean") >= 1.0);
     }

@@ -17,7 +17,7 @@ fn tuned_rho_beats_plain_iteration_on_the_small_dam_break() {
     };
     let mut phases = Vec::new();
     let report = tune_rho(&scene, &config, |p| phases.push(p)).unwrap();
-    assert_eq!(phases.len(), 2 + config.grid.len());
+    assert_eq!(phases.len(), 3 + config.grid.len());
     let plain = &report.plain;
     assert_eq!(plain.solver, "jacobi1");
     assert!(plain.outer_iterations_mean > 5.0, "{plain:?}");
@@ -35,7 +35,11 @@ fn tuned_rho_beats_plain_iteration_on_the_small_dam_break() {
         best.summary.outer_iterations_mean,
         plain.outer_iterations_mean
     );
-    for trial in &report.trials {
+    // The online estimate runs from the same state and reports its mean ρ.
+    let auto = &report.auto;
+    assert!(auto.summary.rho_auto && auto.summary.steps == 10);
+    assert_eq!(auto.rho, auto.summary.rho);
+    for trial in report.trials.iter().chain([auto]) {
         assert_eq!(trial.summary.steps, 10);
         // Deterministic snapshot: every run starts with the same energy.
         assert_eq!(trial.summary.energy_initial, plain.energy_initial);

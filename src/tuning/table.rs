@@ -1,4 +1,5 @@
-//! A ρ sweep as a Markdown table and as CSV: the plain iteration first, then one row per ρ.
+//! A ρ sweep as a Markdown table and as CSV: the plain iteration first, then one row per ρ,
+//! then the online estimate (`auto`).
 
 use super::TuneReport;
 use crate::stats::RunSummary;
@@ -35,6 +36,16 @@ fn rows(report: &TuneReport) -> Vec<Row<'_>> {
             verdict,
         });
     }
+    let auto = &report.auto;
+    rows.push(Row {
+        label: "auto".to_string(),
+        run: &auto.summary,
+        plain,
+        verdict: match auto.rejection {
+            Some(r) => format!("rejected: {r} (mean ρ {:.3})", auto.rho),
+            None => format!("online estimate (mean ρ {:.3})", auto.rho),
+        },
+    });
     rows
 }
 

@@ -130,22 +130,26 @@ fn validate_naming_options(scene: &Scene, options: &[(&str, &str, bool)]) -> Res
 
 /// `projfluid run`.
 pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
-    let (mut scene, mut world, saved_end) = match (&args.resume, &args.scene) {
+    let (mut scene, resumed, saved_end) = match (&args.resume, &args.scene) {
         (Some(path), _) => {
             let c = read_checkpoint(path, args.params.threads)
                 .map_err(|e| Failure::Input(e.to_string()))?;
-            (c.scene, c.world, c.run_end)
+            (c.scene, Some(c.world), c.run_end)
         }
         (None, Some(name)) => {
             let scene = Scene::resolve(name).map_err(|e| Failure::Input(e.to_string()))?;
-            let world = scene
-                .build_world()
-                .map_err(|e| Failure::Input(e.to_string()))?;
-            (scene, world, None)
+            (scene, None, None)
         }
         (None, None) => return Err(Failure::Input("a scene or --resume FILE is needed".into())),
     };
+    // Overrides first: a fresh world is built with them (a resumed one keeps its own).
     let mut target = apply_overrides(&mut scene, args)?;
+    let mut world = match resumed {
+        Some(world) => world,
+        None => scene
+            .build_world()
+            .map_err(|e| Failure::Input(e.to_string()))?,
+    };
     if args.resume.is_some() && args.steps.is_none() && args.duration.is_none() {
         target = match saved_end {
             Some(RunEnd::Steps(n)) => RunLength::Steps(n.saturating_sub(world.steps())),

@@ -91,6 +91,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         ),
         Phase::Plain => eprintln!("plain iteration ({})…", SolverKind::Jacobi1.name()),
         Phase::Rho(rho) => eprintln!("chebyshev, rho {rho}…"),
+        Phase::Auto => eprintln!("chebyshev, rho estimated online…"),
     })
     .map_err(|e| Failure::Runtime(e.to_string()))?;
     let table = tuning::markdown(&report);
@@ -123,7 +124,13 @@ fn conclusion(report: &TuneReport) -> String {
         }
         None => "best rho: none (every value was rejected)".into(),
     };
-    format!("{estimate}\n{choice}")
+    let auto = report.auto.summary.outer_iterations_mean;
+    let online = format!(
+        "rho auto: {auto:.2} outer iterations per step (mean online rho {:.3}, {:+.1} % against plain iteration)",
+        report.auto.rho,
+        (auto / plain - 1.0) * 100.0
+    );
+    format!("{estimate}\n{choice}\n{online}")
 }
 
 /// Writes tune_rho_time.png and tune_rho_iterations.png: time and outer iterations over ρ.

@@ -88,11 +88,13 @@ fn resting_water_column_keeps_its_volume() {
 
 /// The resting column comes to rest: RMS velocity below 1 cm/s after 2 s.
 ///
-/// Known failure: with the reference projection weighting (w_j = n_j + 1) the outer iteration
-/// converges at ≈ 0.98 per iteration in a 16-layer column at Δt = 5 ms, and the displacement
-/// rule leaves a residual that becomes ≈ 3.3 cm/s of velocity noise with the defaults.
+/// Known failure (README, Known limitations): the cubic lattice settles (the top layer sinks
+/// into the hollows below, the bottom layers shift), releasing ≈ 14 J that decays by about half
+/// per second, and at rest the outer iteration keeps a noise floor of ≈ 2 cm/s (a
+/// sign-alternating mode of the (n_j + 1)-weighted iteration); with the defaults the column
+/// still moves at ≈ 3.3 cm/s after 2 s.
 #[test]
-#[ignore = "open: the resting column keeps ≈ 3.3 cm/s RMS velocity noise (README, Known limitations)"]
+#[ignore = "open: the resting column keeps ≈ 3.3 cm/s RMS velocity after 2 s (README, Known limitations)"]
 fn resting_water_column_comes_to_rest() {
     let (world, _, _) = resting_column(2.0);
     let rms = world.rms_velocity();

@@ -1,6 +1,6 @@
 //! Chebyshev semi-iterative acceleration of the outer local/global iteration
-//! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]), with a fixed ρ_c or one estimated online
-//! (§5.3, [`ChebyshevParams::auto_rho`]).
+//! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]), with a fixed ρ_c or one estimated online from
+//! probes of the plain iteration ([`ChebyshevParams::auto_rho`]; README, "Choosing ρ").
 
 use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
@@ -39,7 +39,7 @@ pub struct Chebyshev {
     rho: f64,
     /// Smoothed plain-iteration contraction ρ̂ (online mode), once measured.
     contraction: Option<f64>,
-    /// Steps since the last successful probe.
+    /// Steps since the last probe.
     since_probe: u64,
     /// The current step is a probe: plain iteration, no extrapolation.
     probing: bool,

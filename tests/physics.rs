@@ -64,22 +64,8 @@ fn resting_water_column_keeps_its_volume() {
     assert!(avg <= 1e-3, "average density error {:.4} %", avg * 100.0);
     assert!(worst <= 1e-3, "worst step {:.4} %", worst * 100.0);
 
-    // Volume N·V with V = m/ρ0. Wall particles keep fluid centres one spacing d from the wall
-    // plane and each particle owns a cube of edge d, so the fluid body ends d/2 from every
-    // wall: it fills (L_x − d)(L_z − d) and starts d/2 above the floor.
     let d = world.params().spacing();
-    let volume = world.fluid_count() as f64 * world.particle_mass() / world.params().rest_density;
-    let size = container.max - container.min;
-    let expected = volume / ((size.x - d) * (size.z - d));
-    let positions = world.positions();
-    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
-    let surface: Vec<f64> = positions
-        .iter()
-        .map(|p| p.y)
-        .filter(|&y| y > top - 0.5 * d)
-        .collect();
-    let surface_y = surface.iter().sum::<f64>() / surface.len() as f64 + 0.5 * d;
-    let height = surface_y - (container.min.y + 0.5 * d);
+    let (height, expected) = projfluid::validation::hydrostatic::water_height(&world, &container);
     assert!(
         (height - expected).abs() <= d,
         "water height {height:.4} m, expected {expected:.4} m from N·V/area"

@@ -161,6 +161,28 @@ pub struct Report {
     pub force_balance: f64,
 }
 
+/// The water height in `tank` (m) and the height its volume N·V (V = m/ρ0) implies.
+///
+/// Wall particles keep fluid centres one spacing d from the wall planes and each particle owns
+/// a cube of edge d, so the fluid body ends d/2 from every wall: it fills (L_x − d)(L_z − d)
+/// and starts d/2 above the floor. The measured top is the mean height of the particles within
+/// d/2 of the highest one, plus d/2.
+pub fn water_height(world: &World, tank: &Aabb) -> (f64, f64) {
+    let d = world.params().spacing();
+    let positions = world.positions();
+    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let surface: Vec<f64> = positions
+        .iter()
+        .map(|p| p.y)
+        .filter(|&y| y > top - 0.5 * d)
+        .collect();
+    let surface_y = surface.iter().sum::<f64>() / surface.len().max(1) as f64 + 0.5 * d;
+    let height = surface_y - (tank.min.y + 0.5 * d);
+    let volume = world.fluid_count() as f64 * world.particle_mass() / world.params().rest_density;
+    let size = tank.max - tank.min;
+    (height, volume / ((size.x - d) * (size.z - d)))
+}
+
 /// Lets the tank settle for `setup.settle` seconds and measures it; `progress` receives the
 /// fraction done after each step.
 pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
@@ -206,19 +228,8 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         .map_or((0.0, 0.0), |s| (s.density_error_avg, s.density_error_max));
     let rho0 = world.params().rest_density;
     let g = Vec3::from(world.params().gravity).norm();
-    let positions = world.positions();
     let floor = tank.min.y;
-    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
-    let surface: Vec<f64> = positions
-        .iter()
-        .map(|p| p.y)
-        .filter(|&y| y > top - 0.5 * d)
-        .collect();
-    let surface_y = surface.iter().sum::<f64>() / surface.len().max(1) as f64 + 0.5 * d;
-    let height = surface_y - (floor + 0.5 * d);
-    let volume = world.fluid_count() as f64 * world.particle_mass() / rho0;
-    let size = tank.max - tank.min;
-    let expected_height = volume / ((size.x - d) * (size.z - d));
+    let (height, expected_height) = water_height(&world, &tank);
 
     let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
     let support = support_sum / sampled_steps.max(1) as f64;

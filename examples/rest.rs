@@ -3,9 +3,12 @@
 //!
 //! `cargo run --release --example rest -- TAU_PER_R SOLVER RHO SECONDS PRINT_EVERY GAP_PER_R`
 //! (defaults 3e-3 chebyshev 0.85 2 0.1 2.25). Environment: `SETTLE=s` first runs s seconds with
-//! velocities scaled by `DAMP` (default 0) after every step; `XSPH`, `DTMAX`, `K` override the
-//! viscosity, Δt_max and stiffness; `LAYERS`, `DISP`, `DUMP` print velocity by region,
-//! displacement per initial layer and the last step's δ_k.
+//! velocities scaled by `DAMP` (default 0) after every step; `XSPH`, `DTMAX`, `K`, `GAMMA`,
+//! `DELAY` override the viscosity, Δt_max, stiffness and Chebyshev's γ and delay;
+//! `WEIGHT=uniform|unit` the projection weighting; `FCC=1` fills the tank with a face-centred
+//! cubic packing at rest density (wall gap `FCCGAP`, m) instead of the cubic lattice;
+//! `LAYERS`, `DISP`, `DUMP` print velocity by region, displacement per initial layer and the
+//! last step's δ_k.
 use projfluid::{boundary::Aabb, *};
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -20,6 +23,19 @@ fn main() {
         ..Params::default()
     };
     params.chebyshev.rho = rho;
+    if let Ok(v) = std::env::var("WEIGHT") {
+        params.projection_weight = match v.as_str() {
+            "uniform" => ProjectionWeight::Uniform,
+            "unit" => ProjectionWeight::Unit,
+            _ => ProjectionWeight::NeighborCount,
+        };
+    }
+    if let Ok(v) = std::env::var("GAMMA") {
+        params.chebyshev.gamma = v.parse().unwrap();
+    }
+    if let Ok(v) = std::env::var("DELAY") {
+        params.chebyshev.delay = v.parse().unwrap();
+    }
     if let Ok(v) = std::env::var("XSPH") {
         params.viscosity = v.parse().unwrap();
     }
@@ -37,18 +53,54 @@ fn main() {
     let gap = gap_r * r;
     let floor = d - gap;
     let inner = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
-    world
-        .add_container(
-            Aabb {
-                min: Vec3::repeat(floor),
-                max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
-            },
-            1,
-        )
-        .unwrap();
-    world
-        .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
-        .unwrap();
+    if std::env::var("FCC").is_ok() {
+        let s: f64 = 0.05607;
+        let h = s / 2f64.sqrt();
+        let g: f64 = std::env::var("FCCGAP")
+            .map(|v| v.parse().unwrap())
+            .unwrap_or(0.04);
+        let (nx, layers) = (11usize, 20usize);
+        let mut pts = Vec::new();
+        for l in 0..layers {
+            let odd = l % 2 == 1;
+            let m = if odd { nx - 1 } else { nx };
+            let off = if odd { s / 2.0 } else { 0.0 };
+            for i in 0..m {
+                for k in 0..m {
+                    pts.push(Vec3::new(
+                        g + off + i as f64 * s,
+                        g + l as f64 * h,
+                        g + off + k as f64 * s,
+                    ));
+                }
+            }
+        }
+        let w = (nx - 1) as f64 * s + 2.0 * g;
+        world
+            .add_container(
+                Aabb {
+                    min: Vec3::zeros(),
+                    max: Vec3::new(w, 1.5, w),
+                },
+                1,
+            )
+            .unwrap();
+        let v = vec![Vec3::zeros(); pts.len()];
+        world.add_fluid_particles(&pts, Some(&v)).unwrap();
+    } else {
+        world
+            .add_container(
+                Aabb {
+                    min: Vec3::repeat(floor),
+                    max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
+                },
+                1,
+            )
+            .unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
+            .unwrap();
+    }
     let step_out: f64 = arg(5, "0.1").parse().unwrap();
     let initial = world.positions();
     let settle: f64 = std::env::var("SETTLE")

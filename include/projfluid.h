@@ -127,6 +127,10 @@ typedef enum PfProjectionWeight {
      * w = 1.
      */
     PF_WEIGHT_UNIT = 1,
+    /**
+     * w = the stencil size at rest density for every particle (conservative forces).
+     */
+    PF_WEIGHT_UNIFORM = 2,
 } PfProjectionWeight;
 
 /**

@@ -54,6 +54,9 @@ pub struct DensityConstraint {
     pub rest_density: f64,
     /// Weighting of the projection.
     pub weight: ProjectionWeight,
+    /// Stencil size c = ρ0·(4/3)πH³/m of a fluid at rest density (particles per stencil),
+    /// the weight of [`ProjectionWeight::Uniform`].
+    pub rest_stencil_size: f64,
     /// Write every projection's corrections out, as multi-step ones do (the reference path,
     /// for tests of the single-step shortcut).
     pub materialize_all: bool,
@@ -117,6 +120,17 @@ impl DensityConstraint {
         match self.weight {
             ProjectionWeight::NeighborCount => (nb.fluid.count(j) + 1) as f64,
             ProjectionWeight::Unit => 1.0,
+            ProjectionWeight::Uniform => self.rest_stencil_size,
+        }
+    }
+
+    /// How many stencils the global step counts particle j as a member of: n_j + 1, or c
+    /// for [`ProjectionWeight::Uniform`] (ALGORITHM.md §3.1; README, "Projection weighting").
+    #[inline]
+    pub fn membership(&self, nb: &NeighborLists, j: usize) -> f64 {
+        match self.weight {
+            ProjectionWeight::Uniform => self.rest_stencil_size,
+            _ => (nb.count(j) + 1) as f64,
         }
     }
 

@@ -4,7 +4,7 @@
 
 use crate::constraint::{Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists};
-use crate::params::SolverKind;
+use crate::params::{ProjectionWeight, SolverKind};
 use crate::solver::DiagonalSystem;
 use crate::stats::{StepStats, StepTimings};
 use crate::{Error, Vec3, World, reduce};
@@ -162,7 +162,7 @@ impl World {
                 .diagonal
                 .par_iter_mut()
                 .enumerate()
-                .for_each(|(j, a)| *a = mass + dt2k * (lists.count(j) + 1) as f64);
+                .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
             solver.prepare(&b.system);
 
             // 4. Outer local/global iterations from X^(0) = X^(−1) = s.
@@ -181,6 +181,12 @@ impl World {
             let chebyshev_step = params.solver == SolverKind::Chebyshev;
             let accelerate = chebyshev_step && chebyshev.accelerates();
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
+            // Uniform weighting with one-iteration steps feeds back into ever smaller CFL
+            // steps (README, "Projection weighting"): it always takes two.
+            let min_outer = match constraint.weight {
+                ProjectionWeight::Uniform => params.min_outer_iterations.max(2),
+                _ => params.min_outer_iterations,
+            };
             b.displacements.clear();
             while outer < params.max_outer_iterations {
                 let t = Instant::now();
@@ -198,7 +204,7 @@ impl World {
                         corrections,
                         slots,
                     );
-                    let members = (lists.count(j) + 1) as f64;
+                    let members = constraint.membership(lists, j);
                     *rhs = b.predicted[j] * mass + (current[j] * members + sum) * dt2k;
                 });
                 b.next.copy_from_slice(&b.current);
@@ -216,9 +222,7 @@ impl World {
                 outer += 1;
                 timings.local += t_local;
                 timings.global += t.elapsed().as_secs_f64() - t_local;
-                if outer >= params.min_outer_iterations
-                    && displacement < params.displacement_tolerance
-                {
+                if outer >= min_outer && displacement < params.displacement_tolerance {
                     break;
                 }
             }

@@ -77,6 +77,7 @@ impl World {
                 mass: params.particle_mass(),
                 rest_density: params.rest_density,
                 weight: params.projection_weight,
+                rest_stencil_size: params.rest_stencil_size(),
                 materialize_all: false,
             },
             pool,

@@ -3,7 +3,7 @@
 
 use projfluid::boundary::Aabb;
 use projfluid::scene::Scene;
-use projfluid::{Params, SolverKind, Vec3, World};
+use projfluid::{Params, ProjectionWeight, SolverKind, Vec3, World};
 
 /// Runs `world` until `seconds` of simulated time, calling `each` after every step.
 fn run(world: &mut World, seconds: f64, mut each: impl FnMut(&World)) {
@@ -25,12 +25,11 @@ fn small_dam_break(solver: SolverKind, rho: Option<f64>, threads: usize) -> Worl
 
 /// A closed tank holding a column of water initialised at rest density (mass factor 1),
 /// 12 × 16 × 12 particles, walls one spacing from the outer layers (plus r/4 so that no
-/// corner starts compressed). Returns the world after `seconds` and the worst step's average
-/// density error.
-fn resting_column(seconds: f64) -> (World, Aabb, f64) {
+/// corner starts compressed), built with `params` (whose mass factor is set to 1).
+fn column_world(params: Params) -> (World, Aabb) {
     let params = Params {
         mass_factor: 1.0,
-        ..Params::default()
+        ..params
     };
     let (r, d) = (params.particle_radius, params.spacing());
     let mut world = World::new(params).unwrap();
@@ -46,6 +45,13 @@ fn resting_column(seconds: f64) -> (World, Aabb, f64) {
     world
         .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
         .unwrap();
+    (world, container)
+}
+
+/// The resting column with the default settings after `seconds`, with the worst step's
+/// average density error.
+fn resting_column(seconds: f64) -> (World, Aabb, f64) {
+    let (mut world, container) = column_world(Params::default());
     let mut worst: f64 = 0.0;
     run(&mut world, seconds, |w| {
         worst = worst.max(w.last_step().unwrap().density_error_avg)
@@ -85,6 +91,66 @@ fn resting_water_column_comes_to_rest() {
     let (world, _, _) = resting_column(2.0);
     let rms = world.rms_velocity();
     assert!(rms < 0.01, "rms velocity {rms} m/s after 2 s");
+}
+
+/// With the uniform projection weighting the converged step's constraint forces derive from
+/// one energy, so a tightly converged column (τ = 10⁻³·r) loses kinetic energy steadily as
+/// its lattice settles: it must at least halve from 1 s to 2 s. (With the neighbour-count
+/// weighting the same column gains energy at this τ: README, "Projection weighting".)
+#[test]
+fn uniform_weighting_dissipates_when_converged() {
+    let defaults = Params::default();
+    let params = Params {
+        projection_weight: ProjectionWeight::Uniform,
+        displacement_tolerance: 1e-3 * defaults.particle_radius,
+        ..defaults
+    };
+    let (mut world, _) = column_world(params);
+    run(&mut world, 1.0, |_| {});
+    let at_one = world.kinetic_energy();
+    run(&mut world, 2.0, |w| assert_eq!(w.escaped_count(), 0));
+    let at_two = world.kinetic_energy();
+    assert!(
+        at_two < 0.5 * at_one,
+        "kinetic energy {at_one:.4} J at 1 s, {at_two:.4} J at 2 s"
+    );
+}
+
+/// Net momentum after one step of an irregular, compressed cluster without walls, gravity or
+/// viscosity, as |Σ m v| / Σ m|v| with the given weighting.
+fn cluster_momentum(weight: ProjectionWeight) -> f64 {
+    let params = Params {
+        gravity: [0.0; 3],
+        // XSPH weighs velocities by 1/ρ_j and is not exactly momentum-conserving.
+        viscosity: 0.0,
+        projection_weight: weight,
+        ..Params::default()
+    };
+    let d = params.spacing();
+    let mut world = World::new(params).unwrap();
+    // A lattice at 0.85 d with a deterministic jitter, so that neighbour counts differ.
+    let mut positions = Vec::new();
+    for (i, j, k) in (0..6).flat_map(|i| (0..5).flat_map(move |j| (0..4).map(move |k| (i, j, k)))) {
+        let n = (i * 31 + j * 17 + k * 7) % 11;
+        let jitter = Vec3::new(n as f64, ((n * 3) % 11) as f64, ((n * 5) % 11) as f64);
+        positions.push(Vec3::new(i as f64, j as f64, k as f64) * (0.85 * d) + jitter * (0.01 * d));
+    }
+    world.add_fluid_particles(&positions, None).unwrap();
+    world.step().unwrap();
+    let v = world.velocities();
+    let moving: f64 = v.iter().map(|v| v.norm()).sum();
+    assert!(moving > 0.0, "the cluster must expand");
+    v.iter().sum::<Vec3>().norm() / moving
+}
+
+/// The uniform weighting conserves linear momentum exactly (to round-off); the neighbour-count
+/// weighting, whose weights differ between the members of a stencil, does not.
+#[test]
+fn uniform_weighting_conserves_momentum() {
+    let uniform = cluster_momentum(ProjectionWeight::Uniform);
+    let counted = cluster_momentum(ProjectionWeight::NeighborCount);
+    assert!(uniform < 1e-12, "uniform: |P|/Σm|v| = {uniform:e}");
+    assert!(counted > 1e-4, "neighbour count: |P|/Σm|v| = {counted:e}");
 }
 
 /// The small dam break for 1 s: finite, contained, incompressible to 0.1 %, and its total

@@ -44,6 +44,8 @@ pub enum PfProjectionWeight {
     PF_WEIGHT_NEIGHBOR_COUNT = 0,
     /// w = 1.
     PF_WEIGHT_UNIT = 1,
+    /// w = the stencil size at rest density for every particle (conservative forces).
+    PF_WEIGHT_UNIFORM = 2,
 }
 
 // Enum fields are read from C memory as plain ints before they are checked.
@@ -132,6 +134,7 @@ impl From<&Params> for PfParams {
             projection_weight: match p.projection_weight {
                 ProjectionWeight::NeighborCount => PfProjectionWeight::PF_WEIGHT_NEIGHBOR_COUNT,
                 ProjectionWeight::Unit => PfProjectionWeight::PF_WEIGHT_UNIT,
+                ProjectionWeight::Uniform => PfProjectionWeight::PF_WEIGHT_UNIFORM,
             },
             displacement_tolerance: p.displacement_tolerance,
             min_outer_iterations: small(p.min_outer_iterations),
@@ -189,6 +192,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
     let projection_weight = match code!(projection_weight) {
         0 => ProjectionWeight::NeighborCount,
         1 => ProjectionWeight::Unit,
+        2 => ProjectionWeight::Uniform,
         n => {
             return Err(Failure::invalid(format!(
                 "params->projection_weight must be a PfProjectionWeight, got {n}"

@@ -210,6 +210,7 @@ enum Omega2Name {
 enum WeightName {
     NeighborCount,
     Unit,
+    Uniform,
 }
 
 impl From<Omega2Name> for Omega2Rule {
@@ -235,6 +236,7 @@ impl From<WeightName> for ProjectionWeight {
         match n {
             WeightName::NeighborCount => ProjectionWeight::NeighborCount,
             WeightName::Unit => ProjectionWeight::Unit,
+            WeightName::Uniform => ProjectionWeight::Uniform,
         }
     }
 }
@@ -244,6 +246,7 @@ impl From<ProjectionWeight> for WeightName {
         match w {
             ProjectionWeight::NeighborCount => WeightName::NeighborCount,
             ProjectionWeight::Unit => WeightName::Unit,
+            ProjectionWeight::Uniform => WeightName::Uniform,
         }
     }
 }

@@ -16,7 +16,7 @@ use crate::boundary::Aabb;
 use crate::constraint::{Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use crate::plot::{LineChart, Series, SeriesStyle};
-use crate::{Error, Params, SolverKind, Vec3, World};
+use crate::{Error, Params, ProjectionWeight, SolverKind, Vec3, World};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
@@ -35,6 +35,8 @@ pub struct Setup {
     pub tolerance: Option<f64>,
     /// Worker threads (0 = one per core).
     pub threads: usize,
+    /// Weighting of the local projection.
+    pub weight: ProjectionWeight,
 }
 
 impl Default for Setup {
@@ -47,6 +49,7 @@ impl Default for Setup {
             solver: SolverKind::Chebyshev,
             tolerance: None,
             threads: 0,
+            weight: ProjectionWeight::NeighborCount,
         }
     }
 }
@@ -81,6 +84,7 @@ impl Setup {
             mass_factor: 1.0,
             solver: self.solver,
             threads: self.threads,
+            projection_weight: self.weight,
             displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),
             ..defaults
         };
@@ -373,7 +377,7 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             .zip(&projections)
             .enumerate()
             .map(|(i, (p, proj))| {
-                let weight = (fluid_lists.count(i) + 1) as f64;
+                let weight = c.membership(&fluid_lists, i);
                 (*p, -params.stiffness * proj.lambda * weight / volume)
             })
             .collect();

@@ -113,7 +113,8 @@ pub enum ProjectionWeight {
     /// ones plus inactive "stay" terms). The converged step's constraint forces are then
     /// k·c·Σ_i λ_i ∇_{x_j}C_i, the gradient of one energy, and conserve momentum; with
     /// `NeighborCount` they are scaled per particle by n_j + 1, which is not conservative
-    /// (README, "Projection weighting"). Needs at least 2 outer iterations per step.
+    /// (README, "Projection weighting"). Experimental: it keeps a resting column calm but
+    /// splashing flows gain energy with it.
     Uniform,
 }
 

@@ -4,7 +4,7 @@
 
 use crate::constraint::{Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists};
-use crate::params::{ProjectionWeight, SolverKind};
+use crate::params::SolverKind;
 use crate::solver::DiagonalSystem;
 use crate::stats::{StepStats, StepTimings};
 use crate::{Error, Vec3, World, reduce};
@@ -181,12 +181,6 @@ impl World {
             let chebyshev_step = params.solver == SolverKind::Chebyshev;
             let accelerate = chebyshev_step && chebyshev.accelerates();
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
-            // Uniform weighting with one-iteration steps feeds back into ever smaller CFL
-            // steps (README, "Projection weighting"): it always takes two.
-            let min_outer = match constraint.weight {
-                ProjectionWeight::Uniform => params.min_outer_iterations.max(2),
-                _ => params.min_outer_iterations,
-            };
             b.displacements.clear();
             while outer < params.max_outer_iterations {
                 let t = Instant::now();
@@ -222,7 +216,9 @@ impl World {
                 outer += 1;
                 timings.local += t_local;
                 timings.global += t.elapsed().as_secs_f64() - t_local;
-                if outer >= min_outer && displacement < params.displacement_tolerance {
+                if outer >= params.min_outer_iterations
+                    && displacement < params.displacement_tolerance
+                {
                     break;
                 }
             }

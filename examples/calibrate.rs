@@ -22,6 +22,7 @@ fn main() {
         p.chebyshev.auto_rho = true;
     } else {
         p.chebyshev.rho = a[3].parse().expect("rho");
+        p.chebyshev.auto_rho = false;
     }
     p.chebyshev.delay = a[4].parse().expect("delay");
     p.chebyshev.omega2_rule = Omega2Rule::from_name(&a[5]).expect("omega2");

@@ -23,6 +23,7 @@ fn main() {
         ..Params::default()
     };
     params.chebyshev.rho = rho;
+    params.chebyshev.auto_rho = false;
     if let Ok(v) = std::env::var("WEIGHT") {
         params.projection_weight = match v.as_str() {
             "uniform" => ProjectionWeight::Uniform,

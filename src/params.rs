@@ -129,13 +129,15 @@ pub struct ChebyshevParams {
     pub omega2_rule: Omega2Rule,
     /// Under-relaxation γ in (0, 1].
     pub gamma: f64,
-    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every 20th step runs
+    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every 40th step runs
     /// the plain iteration and measures its contraction ρ̂, and ρ_c = 0.9·ρ̂ (smoothed, clamped
-    /// to [0.5, 0.95]); `rho` is only the value used until the first estimate.
+    /// to [0.5, 0.95]); `rho` is only the value used until the first estimate. Setting a fixed
+    /// ρ (scene `"rho": 0.9`, `--rho 0.9`) turns it off.
     pub auto_rho: bool,
 }
 
-/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
+/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults"); also the
+/// starting value of the online estimate.
 pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.85;
 /// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
 pub const DEFAULT_CHEBYSHEV_DELAY: usize = 1;

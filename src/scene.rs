@@ -517,7 +517,15 @@ mod tests {
         assert!(scene.params.chebyshev.auto_rho);
         let again = Scene::from_json(&scene.to_json()).unwrap();
         assert_eq!(again.params, scene.params);
+        // A fixed ρ_c is the default, and a number after "auto" fixes it again.
         assert!(!Scene::from_json(GOOD).unwrap().params.chebyshev.auto_rho);
+        let fixed = GOOD.replacen(
+            "\"fluid_blocks\"",
+            "\"solver\": {\"rho\": 0.9}, \"fluid_blocks\"",
+            1,
+        );
+        let fixed = Scene::from_json(&fixed).unwrap().params.chebyshev;
+        assert!(!fixed.auto_rho && fixed.rho == 0.9);
         let bad = GOOD.replacen(
             "\"fluid_blocks\"",
             "\"solver\": {\"rho\": \"fast\"}, \"fluid_blocks\"",

@@ -262,6 +262,7 @@ pub fn tune_rho(
         let mut world = snapshot(scene, config.warmup_steps)?;
         let chebyshev = crate::ChebyshevParams {
             rho,
+            auto_rho: false,
             ..scene.params.chebyshev
         };
         world.set_solver(SolverKind::Chebyshev, chebyshev)?;

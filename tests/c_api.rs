@@ -185,6 +185,7 @@ fn rust_reference() -> World {
         solver: SolverKind::Chebyshev,
         chebyshev: ChebyshevParams {
             rho: 0.85,
+            auto_rho: false,
             ..defaults.chebyshev
         },
         threads: 2,

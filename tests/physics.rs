@@ -19,6 +19,7 @@ fn small_dam_break(solver: SolverKind, rho: Option<f64>, threads: usize) -> Worl
     scene.params.threads = threads;
     if let Some(rho) = rho {
         scene.params.chebyshev.rho = rho;
+        scene.params.chebyshev.auto_rho = false;
     }
     scene.build_world().expect("world")
 }

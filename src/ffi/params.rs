@@ -73,7 +73,8 @@ pub struct PfParams {
     pub solver: PfSolver,
     /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_SEED`.
     pub omega2_rule: PfOmega2Rule,
-    /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1). Default 0.85.
+    /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
+    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.85.
     pub chebyshev_rho: f64,
     /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
     pub chebyshev_delay: u32,

@@ -350,7 +350,10 @@ impl SceneFile {
         p.solver = s.kind.unwrap_or(p.solver);
         let c: &mut ChebyshevParams = &mut p.chebyshev;
         match s.rho {
-            Some(RhoSetting::Value(v)) => c.rho = v,
+            Some(RhoSetting::Value(v)) => {
+                c.rho = v;
+                c.auto_rho = false;
+            }
             Some(RhoSetting::Auto) => c.auto_rho = true,
             None => {}
         }

@@ -9,7 +9,7 @@ use serde::{Deserialize, Serialize};
 
 /// With `auto_rho`, every this many steps one step runs the plain iteration (a probe) to
 /// measure its contraction.
-pub const AUTO_PROBE_INTERVAL: u64 = 20;
+pub const AUTO_PROBE_INTERVAL: u64 = 40;
 /// A probe needs at least this many outer iterations to give an estimate.
 pub const AUTO_MIN_PROBE_ITERATIONS: usize = 20;
 /// ρ_c = κ·ρ̂ with ρ̂ the smoothed contraction of the probes (README, "Choosing ρ").

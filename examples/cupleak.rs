@@ -6,35 +6,14 @@
 //! (Chebyshev with `--rho auto`). The default solver prints nothing; `jacobi1` and `auto`
 //! print one particle slipping ≈ 1 mm into a rim corner (README, Known limitations).
 
+#[path = "../tests/support/cup.rs"]
+mod cup;
+
+use cup::thin_walled_cup;
 use projfluid::boundary::Aabb;
-use projfluid::boundary::mesh::TriangleMesh;
-use projfluid::boundary::shapes::Shapes;
 use projfluid::boundary::winding::is_inside;
 use projfluid::{Params, Vec3, World};
 
-/// A square cup standing on y = 0: a floor slab and four walls, all `wall` metres thick,
-/// outer size 0.3 × 0.25 × 0.3 m, centred on x = z = 0.4. Closed shells that touch.
-fn thin_walled_cup(wall: f64) -> TriangleMesh {
-    let (lo, hi, top) = (0.25, 0.55, 0.25);
-    let mut shapes = Shapes::new();
-    shapes.add_box(Vec3::new(lo, 0.0, lo), Vec3::new(hi, wall, hi));
-    shapes.add_box(Vec3::new(lo, wall, lo), Vec3::new(lo + wall, top, hi));
-    shapes.add_box(Vec3::new(hi - wall, wall, lo), Vec3::new(hi, top, hi));
-    shapes.add_box(
-        Vec3::new(lo + wall, wall, lo),
-        Vec3::new(hi - wall, top, lo + wall),
-    );
-    shapes.add_box(
-        Vec3::new(lo + wall, wall, hi - wall),
-        Vec3::new(hi - wall, top, hi),
-    );
-    shapes.into_mesh().unwrap()
-}
-
-/// A block of water falls onto a cup whose walls are 2 cm thick (less than r = 2.5 cm and a
-/// fifth of the kernel support): part of it lands in the cup, the rest splashes around it.
-/// After every step no particle centre may lie inside the walls or outside the tank. Steps
-/// move particles at most 0.2·2r = 1 cm (CFL), so a particle crossing a wall would be seen
 fn main() {
     let cup = thin_walled_cup(0.02);
     let solver = std::env::args().nth(1).unwrap_or("jacobi1".into());

@@ -9,10 +9,9 @@
 #[path = "../tests/support/cup.rs"]
 mod cup;
 
-use cup::thin_walled_cup;
-use projfluid::boundary::Aabb;
+use cup::{pour_over_cup, thin_walled_cup};
+use projfluid::Params;
 use projfluid::boundary::winding::is_inside;
-use projfluid::{Params, Vec3, World};
 
 fn main() {
     let cup = thin_walled_cup(0.02);
@@ -26,16 +25,7 @@ fn main() {
     } else {
         params.solver = projfluid::SolverKind::from_name(&solver).unwrap();
     }
-    let mut world = World::new(params).unwrap();
-    let tank = Aabb {
-        min: Vec3::repeat(-0.00625),
-        max: Vec3::new(0.80625, 0.90625, 0.80625),
-    };
-    world.add_container(tank, 1).unwrap();
-    world.add_boundary_mesh(&cup).unwrap();
-    world
-        .add_fluid_block(Vec3::new(0.125, 0.35, 0.125), [12, 6, 12], Vec3::zeros())
-        .unwrap();
+    let mut world = pour_over_cup(params, &cup);
     let b = world.boundary_positions().to_vec();
     while world.time() < 0.8 {
         let s = world.step().unwrap().clone();

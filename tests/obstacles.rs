@@ -4,10 +4,9 @@
 #[path = "support/cup.rs"]
 mod cup;
 
-use cup::thin_walled_cup;
-use projfluid::boundary::Aabb;
+use cup::{pour_over_cup, thin_walled_cup};
+use projfluid::Params;
 use projfluid::boundary::winding::{is_closed_and_oriented, is_inside};
-use projfluid::{Params, Vec3, World};
 
 /// A block of water falls onto a cup whose walls are 2 cm thick (less than r = 2.5 cm and a
 /// fifth of the kernel support): part of it lands in the cup, the rest splashes around it.
@@ -18,21 +17,11 @@ use projfluid::{Params, Vec3, World};
 fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
     let cup = thin_walled_cup(0.02);
     assert!(is_closed_and_oriented(&cup));
-    let mut world = World::new(Params {
+    let params = Params {
         threads: 2,
         ..Params::default()
-    })
-    .unwrap();
-    let tank = Aabb {
-        min: Vec3::repeat(-0.00625),
-        max: Vec3::new(0.80625, 0.90625, 0.80625),
     };
-    world.add_container(tank, 1).unwrap();
-    world.add_boundary_mesh(&cup).unwrap();
-    // 12 × 6 × 12 particles above the cup, overhanging it by about 0.1 m on every side.
-    world
-        .add_fluid_block(Vec3::new(0.125, 0.35, 0.125), [12, 6, 12], Vec3::zeros())
-        .unwrap();
+    let mut world = pour_over_cup(params, &cup);
     let (mut in_cup_at_end, mut worst_inside, mut worst_escaped) = (0, 0, 0);
     while world.time() < 0.8 {
         world.step().unwrap();

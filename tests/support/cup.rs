@@ -1,8 +1,9 @@
 //! The thin-walled cup of the no-leak test, shared with `examples/cupleak.rs`.
 
-use projfluid::Vec3;
+use projfluid::boundary::Aabb;
 use projfluid::boundary::mesh::TriangleMesh;
 use projfluid::boundary::shapes::Shapes;
+use projfluid::{Params, Vec3, World};
 
 /// A square cup standing on y = 0: a floor slab and four walls, all `wall` metres thick,
 /// outer size 0.3 × 0.25 × 0.3 m, centred on x = z = 0.4. Closed shells that touch.
@@ -21,4 +22,20 @@ pub fn thin_walled_cup(wall: f64) -> TriangleMesh {
         Vec3::new(hi - wall, top, hi),
     );
     shapes.into_mesh().unwrap()
+}
+
+/// The no-leak scene with `params`: a 0.8 × 0.9 × 0.8 m tank, `cup` in it, and 12 × 6 × 12
+/// particles above the cup, overhanging it by about 0.1 m on every side.
+pub fn pour_over_cup(params: Params, cup: &TriangleMesh) -> World {
+    let mut world = World::new(params).unwrap();
+    let tank = Aabb {
+        min: Vec3::repeat(-0.00625),
+        max: Vec3::new(0.80625, 0.90625, 0.80625),
+    };
+    world.add_container(tank, 1).unwrap();
+    world.add_boundary_mesh(cup).unwrap();
+    world
+        .add_fluid_block(Vec3::new(0.125, 0.35, 0.125), [12, 6, 12], Vec3::zeros())
+        .unwrap();
+    world
 }

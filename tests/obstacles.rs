@@ -4,30 +4,30 @@
 #[path = "support/cup.rs"]
 mod cup;
 
-use cup::{pour_over_cup, thin_walled_cup};
-use projfluid::Params;
-use projfluid::boundary::winding::{is_closed_and_oriented, is_inside};
+use cup::{cup_boxes, depth_inside, pour_over_cup, thin_walled_cup};
+use projfluid::boundary::winding::is_closed_and_oriented;
+use projfluid::{Params, SolverKind};
 
 /// A block of water falls onto a cup whose walls are 2 cm thick (less than r = 2.5 cm and a
 /// fifth of the kernel support): part of it lands in the cup, the rest splashes around it.
-/// After every step no particle centre may lie inside the walls or outside the tank. Steps
-/// move particles at most 0.2·2r = 1 cm (CFL), so a particle crossing a wall would be seen
-/// inside it for at least one step.
-#[test]
-fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
+/// After every step no particle centre may lie 5 mm (r/5) or deeper inside the walls, and
+/// none outside the tank. Steps move particles at most 0.2·2r = 1 cm (CFL), so a particle
+/// crossing a 2 cm wall would be seen at least 5 mm deep for at least one step. (A particle
+/// grazing a convex corner of the rim alone, with few neighbours and so a soft constraint,
+/// may dip a few millimetres into it: README, Known limitations.)
+fn pour_and_check(params: Params) {
     let cup = thin_walled_cup(0.02);
     assert!(is_closed_and_oriented(&cup));
-    let params = Params {
-        threads: 2,
-        ..Params::default()
-    };
     let mut world = pour_over_cup(params, &cup);
-    let (mut in_cup_at_end, mut worst_inside, mut worst_escaped) = (0, 0, 0);
+    let boxes = cup_boxes(0.02);
+    let (mut in_cup_at_end, mut worst_escaped, mut deepest) = (0, 0, 0.0f64);
     while world.time() < 0.8 {
         world.step().unwrap();
         let positions = world.positions();
-        let inside = positions.iter().filter(|p| is_inside(&cup, p)).count();
-        worst_inside = worst_inside.max(inside);
+        deepest = positions
+            .iter()
+            .map(|p| depth_inside(&boxes, p))
+            .fold(deepest, f64::max);
         worst_escaped = worst_escaped.max(world.escaped_count());
         assert_eq!(world.nan_count(), 0);
         in_cup_at_end = positions
@@ -35,7 +35,10 @@ fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
             .filter(|p| (0.27..0.53).contains(&p.x) && (0.27..0.53).contains(&p.z) && p.y < 0.25)
             .count();
     }
-    assert_eq!(worst_inside, 0, "particles inside the cup's walls");
+    assert!(
+        deepest < 0.2 * world.params().particle_radius,
+        "a particle centre was {deepest:.4} m deep inside the cup's walls"
+    );
     assert_eq!(worst_escaped, 0, "particles outside the tank");
     // The test must exercise both sides of the walls: water in the cup and around it.
     let n = world.fluid_count();
@@ -43,4 +46,23 @@ fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
         in_cup_at_end > n / 10 && in_cup_at_end < n * 9 / 10,
         "{in_cup_at_end} of {n} particles ended in the cup"
     );
+}
+
+/// The default solver keeps the water out of the cup's walls.
+#[test]
+fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
+    pour_and_check(Params {
+        threads: 2,
+        ..Params::default()
+    });
+}
+
+/// So does the plain iteration (which `--rho auto` also runs in its probe steps).
+#[test]
+fn plain_iteration_does_not_leak_through_thin_walls_either() {
+    pour_and_check(Params {
+        threads: 2,
+        solver: SolverKind::Jacobi1,
+        ..Params::default()
+    });
 }

@@ -154,10 +154,13 @@ const ROUNDS: usize = 10;
 const SEED: u64 = 0x5eed_5eed_9e37_79b9;
 
 /// Poisson-disk samples of the surface of `mesh`: points on its triangles, no two closer
-/// than `min_distance` (m), and every surface point within about 1.4·`min_distance` of a
+/// than `min_distance` (m; to a relative 10⁻⁶), and every surface point within about 1.4·`min_distance` of a
 /// sample (the sampling is maximal on a lattice of spacing `min_distance`/3).
 ///
-/// Method (Bowers et al. 2010, as in SPlisHSPlasH): about 40·area/(π·min_distance²) random
+/// Method: first every sharp edge (see `feature_edges`: an open border, or a fold of more
+/// than 30°) is sampled evenly at a spacing of at most `min_distance`, so that a fold such
+/// as a thin wall's rim leaves no gap for fluid to squeeze through. Then (Bowers et al.
+/// 2010, as in SPlisHSPlasH) about 40·area/(π·min_distance²) random
 /// candidates are drawn (triangles chosen with probability proportional to area, uniform
 /// barycentric coordinates, a fixed-seed generator), binned into cells of size
 /// min_distance/√3, and the cells are visited in 27 phase groups (cell index mod 3 per
@@ -177,6 +180,16 @@ pub fn sample_poisson_disk(mesh: &TriangleMesh, min_distance: f64) -> Vec<Vec3> 
         return Vec::new();
     }
     let mut samples = SampleGrid::new(mesh.bounds().min, min_distance);
+
+    // Sharp edges first, evenly at a spacing of at most `min_distance`, so that the fluid
+    // finds no gap where the surface folds (random samples keep ≈ min_distance/2 from it).
+    for (a, b) in feature_edges(mesh) {
+        // Lengths a whole multiple of the distance, read in f32 or f64, give the same count.
+        let n = steps((b - a).norm() * (1.0 - 1e-6), min_distance);
+        for i in 0..=n {
+            samples.insert_if_free(a + (b - a) * (i as f64 / n as f64));
+        }
+    }
 
     // Candidates, sorted by cell (stable, so equal cells keep their drawing order).
     let mut candidates = random_candidates(mesh, min_distance);
@@ -225,6 +238,42 @@ pub fn sample_poisson_disk(mesh: &TriangleMesh, min_distance: f64) -> Vec<Vec3> 
         }
     }
     samples.points
+}
+
+/// Cosine of the smallest dihedral fold that counts as a sharp edge: faces meeting at more
+/// than 30° from flat (a box's edges, a cup's rim), while finely tessellated curved
+/// surfaces have much smaller folds.
+const SHARP_FOLD_COS: f64 = 0.866_025_403_784_438_6;
+
+/// The mesh's feature edges as pairs of corner positions (m), in a deterministic order:
+/// edges (by vertex index) used by only one triangle, by three or more, or by two whose
+/// normals differ by more than 30°.
+fn feature_edges(mesh: &TriangleMesh) -> Vec<(Vec3, Vec3)> {
+    let mut faces: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (i, j) = (tri[k], tri[(k + 1) % 3]);
+            faces.entry((i.min(j), i.max(j))).or_default().push(t);
+        }
+    }
+    let normal = |t: usize| {
+        let [a, b, c] = mesh.corners(t);
+        (b - a).cross(&(c - a)).normalize()
+    };
+    let mut edges: Vec<(u32, u32)> = faces
+        .iter()
+        .filter(|(_, ts)| match ts.as_slice() {
+            // Winding may be mixed, so a fold is measured without the normals' signs.
+            [s, t] => normal(*s).dot(&normal(*t)).abs() < SHARP_FOLD_COS,
+            _ => true,
+        })
+        .map(|(&e, _)| e)
+        .collect();
+    edges.sort_unstable();
+    edges
+        .into_iter()
+        .map(|(i, j)| (mesh.vertices[i as usize], mesh.vertices[j as usize]))
+        .collect()
 }
 
 /// The number of equal steps of at most `spacing` that cover `length` (at least 1).
@@ -328,7 +377,7 @@ impl SampleGrid {
         Self {
             origin,
             cell_size: min_distance / 3f64.sqrt(),
-            min_distance_squared: min_distance * min_distance,
+            min_distance_squared: min_distance * min_distance * (1.0 - 2e-6),
             heads: HashMap::default(),
             next: Vec::new(),
             points: Vec::new(),
@@ -360,8 +409,10 @@ impl SampleGrid {
             .fold(0, |phase, &i| 3 * phase + i.rem_euclid(3) as usize)
     }
 
-    /// Adds `p` unless an accepted sample lies closer than the minimum distance (or, beyond
-    /// any realistic use, the sample indices are exhausted).
+    /// Adds `p` unless an accepted sample lies closer than the minimum distance by more than
+    /// a relative 10⁻⁶ (so that points exactly the minimum distance apart, such as samples
+    /// along an edge, are kept whether the mesh came in f32 or f64), or, beyond any
+    /// realistic use, the sample indices are exhausted.
     fn insert_if_free(&mut self, p: Vec3) {
         if self.points.len() >= NONE as usize {
             return;
@@ -509,7 +560,7 @@ mod tests {
             }
         }
         assert!(
-            min_pair >= R * (1.0 - 1e-9),
+            min_pair >= R * (1.0 - 1e-6),
             "two samples are {min_pair} m apart, closer than r = {R}"
         );
         // Every surface point lies within 1.5 r of a sample.
@@ -543,6 +594,37 @@ mod tests {
         let density = samples.len() as f64 * R * R / mesh.area();
         assert!((0.55..0.85).contains(&density), "density {density}");
         assert!(samples.len() as f64 <= sample_count_bound(&mesh, R));
+    }
+
+    /// Sharp edges are sampled evenly: every corner is a sample and every point of the
+    /// twelve edges of a box lies within r/2 of one, while a flat diagonal is not an edge.
+    #[test]
+    fn box_edges_and_corners_are_sampled_evenly() {
+        let (min, max) = (Vec3::new(0.1, 0.2, 0.3), Vec3::new(0.5, 0.3, 0.45));
+        let mesh = box_mesh(min, max);
+        assert_eq!(feature_edges(&mesh).len(), 12);
+        let nearest = Nearest::new(&sample_poisson_disk(&mesh, R), R);
+        let corners = mesh.vertices().to_vec();
+        for a in &corners {
+            assert!(
+                nearest.distance(a, 1) < 1e-12,
+                "corner {a:?} is not a sample"
+            );
+            for b in &corners {
+                let along = (b - a).map(|c| (c.abs() > 1e-12) as u8).sum();
+                if along != 1 {
+                    continue;
+                }
+                for i in 0..=100 {
+                    let p = a + (b - a) * (i as f64 / 100.0);
+                    let d = nearest.distance(&p, 2);
+                    assert!(
+                        d <= 0.5 * R * (1.0 + 1e-6),
+                        "{p:?} on an edge is {d} m from every sample"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

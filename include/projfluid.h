@@ -214,7 +214,7 @@ typedef struct PfParams {
     double chebyshev_gamma;
     /**
      * 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
-     * value); 0: use `chebyshev_rho` throughout. Default 0.
+     * value); 0: use `chebyshev_rho` throughout (set it to 0 to fix ρ_c). Default 1.
      */
     uint32_t chebyshev_auto_rho;
     /**

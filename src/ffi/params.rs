@@ -81,7 +81,7 @@ pub struct PfParams {
     /// Under-relaxation γ of the Chebyshev step, in (0, 1]. Default 1.
     pub chebyshev_gamma: f64,
     /// 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
-    /// value); 0: use `chebyshev_rho` throughout. Default 0.
+    /// value); 0: use `chebyshev_rho` throughout (set it to 0 to fix ρ_c). Default 1.
     pub chebyshev_auto_rho: u32,
     /// Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
     pub projection_weight: PfProjectionWeight,

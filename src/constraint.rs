@@ -74,9 +74,18 @@ pub struct Projection {
     pub materialized: bool,
 }
 
+/// Per-thread buffers of one projection: the offsets x_i − x_j and their lengths (m) of the
+/// first density evaluation, fluid and boundary members in stencil order, reused by the
+/// first gradient evaluation; and the gradients of the current step.
+#[derive(Default)]
+struct Scratch {
+    fluid: Vec<(Vec3, f64)>,
+    boundary: Vec<(Vec3, f64)>,
+    grads: Vec<Vec3>,
+}
+
 thread_local! {
-    /// Per-thread buffer for the gradients of one stencil.
-    static SCRATCH: std::cell::RefCell<Vec<Vec3>> = const { std::cell::RefCell::new(Vec::new()) };
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::new(Scratch::default());
 }
 
 impl DensityConstraint {
@@ -103,6 +112,63 @@ impl DensityConstraint {
             })
             .sum();
         self.mass * (k.w_zero() + fluid) + boundary
+    }
+
+    /// [`Self::density_at`] at the iterate (`xi` = x_i, neighbours at `x`), keeping every
+    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. Same result,
+    /// bit for bit.
+    #[inline]
+    fn first_density(
+        &self,
+        i: usize,
+        xi: Vec3,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let k = &self.kernel;
+        scratch.fluid.clear();
+        scratch.boundary.clear();
+        let mut fluid = 0.0;
+        for &j in nb.fluid.of(i) {
+            let r = xi - x[j as usize];
+            let len = r.norm();
+            fluid += k.w(len);
+            scratch.fluid.push((r, len));
+        }
+        let mut boundary = 0.0;
+        for &b in nb.boundary.of(i) {
+            let b = b as usize;
+            let r = xi - nb.boundary_positions[b];
+            let len = r.norm();
+            boundary += nb.boundary_psi[b] * k.w(len);
+            scratch.boundary.push((r, len));
+        }
+        self.mass * (k.w_zero() + fluid) + boundary
+    }
+
+    /// [`Self::gradients`] at the iterate, from the offsets [`Self::first_density`] kept.
+    #[inline]
+    fn first_gradients(&self, i: usize, nb: &Neighborhood, scratch: &mut Scratch) -> (Vec3, f64) {
+        let kernel = &self.kernel;
+        let scale = self.mass / self.rest_density;
+        let mut grad_i: Vec3 = nb
+            .boundary
+            .of(i)
+            .iter()
+            .zip(&scratch.boundary)
+            .map(|(&b, (r, len))| kernel.grad_w_at(r, *len) * nb.boundary_psi[b as usize])
+            .sum::<Vec3>()
+            / self.rest_density;
+        let mut denominator = 0.0;
+        scratch.grads.clear();
+        for (r, len) in &scratch.fluid {
+            let g = kernel.grad_w_at(r, *len) * scale;
+            grad_i += g;
+            denominator += g.norm_squared();
+            scratch.grads.push(-g);
+        }
+        (grad_i, denominator + grad_i.norm_squared())
     }
 
     /// SPH density ρ_i (kg/m³) of every fluid particle at `positions`, written into `out`.
@@ -228,7 +294,7 @@ impl DensityConstraint {
         nb: &Neighborhood,
         dp: &mut [Vec3],
         out: &mut Projection,
-        grads: &mut Vec<Vec3>,
+        scratch: &mut Scratch,
     ) {
         *out = Projection::default();
         let members = nb.fluid.of(i);
@@ -238,11 +304,11 @@ impl DensityConstraint {
         for step in 0..MAX_PROJECTION_STEPS {
             let pi = x[i] + out.self_correction;
             let rho = match (step, materialized) {
-                (0, _) => self.density_at(i, pi, at, nb),
+                (0, _) => self.first_density(i, pi, x, nb, scratch),
                 (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
                 (_, false) => {
-                    let lambda = out.lambda;
+                    let (lambda, grads) = (out.lambda, &scratch.grads);
                     self.density_at(i, pi, |s| at(s) + grads[s] * (lambda * w(s)), nb)
                 }
             };
@@ -250,7 +316,7 @@ impl DensityConstraint {
             if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
                 // A second step is needed (or requested): write the first step's corrections out.
                 dp[0] = out.self_correction;
-                for (s, g) in grads.iter().enumerate() {
+                for (s, g) in scratch.grads.iter().enumerate() {
                     dp[s + 1] = g * (out.lambda * w(s));
                 }
                 materialized = true;
@@ -259,9 +325,10 @@ impl DensityConstraint {
                 break;
             }
             let (grad_i, denominator) = if materialized {
-                self.gradients(i, pi, |s| at(s) + dp[s + 1], nb, grads)
+                self.gradients(i, pi, |s| at(s) + dp[s + 1], nb, &mut scratch.grads)
             } else {
-                self.gradients(i, pi, at, nb, grads)
+                // Only the first step is not materialized: the iterate's offsets are kept.
+                self.first_gradients(i, nb, scratch)
             };
             if denominator == 0.0 {
                 break;
@@ -269,7 +336,7 @@ impl DensityConstraint {
             let lambda = -c / (denominator + REGULARIZATION);
             out.self_correction += grad_i * (lambda * self.weight_of(nb, i));
             if materialized {
-                for (s, g) in grads.iter().enumerate() {
+                for (s, g) in scratch.grads.iter().enumerate() {
                     dp[s + 1] += g * (lambda * w(s));
                 }
                 dp[0] = out.self_correction;

@@ -57,7 +57,12 @@ impl CubicKernel {
     /// in 1/m⁴.
     #[inline]
     pub fn grad_w(&self, r: &Vec3) -> Vec3 {
-        let len = r.norm();
+        self.grad_w_at(r, r.norm())
+    }
+
+    /// [`CubicKernel::grad_w`] for `r` whose length `len` = |r| (m) is already known.
+    #[inline]
+    pub fn grad_w_at(&self, r: &Vec3, len: f64) -> Vec3 {
         let q = len / self.support_radius;
         if len <= GRADIENT_CUTOFF || q > 1.0 {
             return Vec3::zeros();

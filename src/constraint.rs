@@ -74,14 +74,16 @@ pub struct Projection {
     pub materialized: bool,
 }
 
-/// Per-thread buffers of one projection: the offsets x_i − x_j and their lengths (m) of the
-/// first density evaluation, fluid and boundary members in stencil order, reused by the
-/// first gradient evaluation; and the gradients of the current step.
+/// Per-thread buffers of one projection: the offsets x_i − x_j (m) and their lengths of the
+/// first density evaluation, fluid and boundary members in stencil order (boundary ones with
+/// their ψ_b, kg), reused by the first gradient evaluation and the density after the first
+/// step; the gradients of the current step; and the fluid members' weights w_j.
 #[derive(Default)]
 struct Scratch {
     fluid: Vec<(Vec3, f64)>,
-    boundary: Vec<(Vec3, f64)>,
+    boundary: Vec<(Vec3, f64, f64)>,
     grads: Vec<Vec3>,
+    weights: Vec<f64>,
 }
 
 thread_local! {
@@ -139,10 +141,10 @@ impl DensityConstraint {
         let mut boundary = 0.0;
         for &b in nb.boundary.of(i) {
             let b = b as usize;
-            let r = xi - nb.boundary_positions[b];
+            let (r, psi) = (xi - nb.boundary_positions[b], nb.boundary_psi[b]);
             let len = r.norm();
-            boundary += nb.boundary_psi[b] * k.w(len);
-            scratch.boundary.push((r, len));
+            boundary += psi * k.w(len);
+            scratch.boundary.push((r, len, psi));
         }
         self.mass * (k.w_zero() + fluid) + boundary
     }
@@ -152,23 +154,45 @@ impl DensityConstraint {
     fn first_gradients(&self, i: usize, nb: &Neighborhood, scratch: &mut Scratch) -> (Vec3, f64) {
         let kernel = &self.kernel;
         let scale = self.mass / self.rest_density;
-        let mut grad_i: Vec3 = nb
+        let mut grad_i: Vec3 = scratch
             .boundary
-            .of(i)
             .iter()
-            .zip(&scratch.boundary)
-            .map(|(&b, (r, len))| kernel.grad_w_at(r, *len) * nb.boundary_psi[b as usize])
+            .map(|(r, len, psi)| kernel.grad_w_at(r, *len) * *psi)
             .sum::<Vec3>()
             / self.rest_density;
         let mut denominator = 0.0;
         scratch.grads.clear();
-        for (r, len) in &scratch.fluid {
+        scratch.weights.clear();
+        for ((r, len), &j) in scratch.fluid.iter().zip(nb.fluid.of(i)) {
             let g = kernel.grad_w_at(r, *len) * scale;
             grad_i += g;
             denominator += g.norm_squared();
             scratch.grads.push(-g);
+            scratch.weights.push(self.weight_of(nb, j as usize));
         }
         (grad_i, denominator + grad_i.norm_squared())
+    }
+
+    /// ρ_i after the first projection step `first` (λ and the centre's correction), from the
+    /// offsets kept by [`Self::first_density`] and the gradients and weights of
+    /// [`Self::first_gradients`]: p_i − p_j = (x_i − x_j) + Δp_i − λ w_j ∇_{x_j}C_i.
+    #[inline]
+    fn first_step_density(&self, first: &Projection, scratch: &Scratch) -> f64 {
+        let k = &self.kernel;
+        let (lambda, shift) = (first.lambda, first.self_correction);
+        let fluid: f64 = scratch
+            .fluid
+            .iter()
+            .zip(&scratch.grads)
+            .zip(&scratch.weights)
+            .map(|(((r, _), g), w)| k.w((r + shift - g * (lambda * w)).norm()))
+            .sum();
+        let boundary: f64 = scratch
+            .boundary
+            .iter()
+            .map(|(r, _, psi)| psi * k.w((r + shift).norm()))
+            .sum();
+        self.mass * (k.w_zero() + fluid) + boundary
     }
 
     /// SPH density ρ_i (kg/m³) of every fluid particle at `positions`, written into `out`.
@@ -307,17 +331,14 @@ impl DensityConstraint {
                 (0, _) => self.first_density(i, pi, x, nb, scratch),
                 (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
-                (_, false) => {
-                    let (lambda, grads) = (out.lambda, &scratch.grads);
-                    self.density_at(i, pi, |s| at(s) + grads[s] * (lambda * w(s)), nb)
-                }
+                (_, false) => self.first_step_density(out, scratch),
             };
             let c = (rho / self.rest_density - 1.0).max(0.0);
             if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
                 // A second step is needed (or requested): write the first step's corrections out.
                 dp[0] = out.self_correction;
-                for (s, g) in scratch.grads.iter().enumerate() {
-                    dp[s + 1] = g * (out.lambda * w(s));
+                for (s, (g, w)) in scratch.grads.iter().zip(&scratch.weights).enumerate() {
+                    dp[s + 1] = g * (out.lambda * w);
                 }
                 materialized = true;
             }

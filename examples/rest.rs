@@ -8,7 +8,7 @@
 //! `WEIGHT=uniform|unit` the projection weighting; `FCC=1` fills the tank with a face-centred
 //! cubic packing at rest density (wall gap `FCCGAP`, m) instead of the cubic lattice;
 //! `LAYERS`, `DISP`, `DUMP` print velocity by region, displacement per initial layer and the
-//! last step's δ_k.
+//! last step's δ_k; `NY` sets the column's height in particles (default 16).
 use projfluid::{boundary::Aabb, *};
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -49,7 +49,13 @@ fn main() {
     params.displacement_tolerance = tau_r * params.particle_radius;
     let (r, d) = (params.particle_radius, params.spacing());
     let mut world = World::new(params).unwrap();
-    let n = [12usize, 16, 12];
+    let n = [
+        12usize,
+        std::env::var("NY")
+            .map(|v| v.parse().unwrap())
+            .unwrap_or(16),
+        12,
+    ];
     let gap_r: f64 = arg(6, "2.25").parse().unwrap();
     let gap = gap_r * r;
     let floor = d - gap;

@@ -70,16 +70,46 @@ pub struct Projection {
     pub lambda: f64,
     /// The correction of the constraint's own particle, P_{i,i} − x_i (m).
     pub self_correction: Vec3,
-    /// The neighbours' corrections were written to the stencil buffer (multi-step projection).
+    /// The neighbours' corrections were written out (multi-step projection), to the segment
+    /// of [`Corrections`] that starts at `segment`.
     pub materialized: bool,
+    /// Start of this constraint's segment in [`Corrections`] (meaningful when `materialized`).
+    pub segment: u32,
 }
 
-/// Per-thread buffers of one projection: the offsets x_i − x_j (m) and their lengths of the
+/// The stencil corrections P_{i,j} − x_j (m) of the multi-step projections of one local step,
+/// and of those only: constraint i's segment holds its own correction and then one per fluid
+/// neighbour in stencil order. Single-step projections, the usual case, keep λ_i alone, so
+/// this stays small (it used to be one entry per stencil member of every particle).
+#[derive(Clone, Debug, Default)]
+pub struct Corrections {
+    /// The constraints with a segment, in index order.
+    owners: Vec<u32>,
+    /// Segment k spans `data[offsets[k]..offsets[k + 1]]`.
+    offsets: Vec<u32>,
+    data: Vec<Vec3>,
+}
+
+impl Corrections {
+    /// Number of stored corrections (one per member of every multi-step projection).
+    pub fn len(&self) -> usize {
+        self.data.len()
+    }
+
+    /// Whether no projection of the last local step took more than one step.
+    pub fn is_empty(&self) -> bool {
+        self.data.is_empty()
+    }
+}
+
+/// Per-thread buffers of one projection: its corrections when they are not kept; the offsets x_i − x_j (m) and their lengths of the
 /// first density evaluation, fluid and boundary members in stencil order (boundary ones with
 /// their ψ_b, kg), reused by the first gradient evaluation and the density after the first
 /// step; the gradients of the current step; and the fluid members' weights w_j.
 #[derive(Default)]
 struct Scratch {
+    /// The stencil corrections of a projection whose segment is not kept.
+    dp: Vec<Vec3>,
     fluid: Vec<(Vec3, f64)>,
     boundary: Vec<(Vec3, f64, f64)>,
     grads: Vec<Vec3>,
@@ -226,24 +256,53 @@ impl DensityConstraint {
 
     /// The local step: projects every constraint i at the iterate `x`. Single-step projections
     /// (the usual case) keep only λ_i; longer ones write their stencil corrections
-    /// P_{i,j} − x_j (m) into `corrections` (segments given by [`Neighborhood::stencil_offsets`]).
+    /// P_{i,j} − x_j (m) into `corrections`: once all constraints are projected, the few
+    /// multi-step ones are projected again into segments sized for them alone (a projection
+    /// is a pure function of `x`, so the second pass repeats the first bit for bit).
     pub fn project(
         &self,
         x: &[Vec3],
         nb: &Neighborhood,
         projections: &mut Vec<Projection>,
-        corrections: &mut Vec<Vec3>,
+        corrections: &mut Corrections,
     ) {
         projections.resize(x.len(), Projection::default());
-        corrections.resize(nb.stencil_len(), Vec3::zeros());
-        par_segments_zip_mut(
-            nb.stencil_offsets,
-            corrections,
-            projections,
-            |i, dp, out| {
-                SCRATCH.with_borrow_mut(|scratch| self.project_one(i, x, nb, dp, out, scratch))
-            },
+        let project = |i: usize, dp: &mut [Vec3], out: &mut Projection| {
+            SCRATCH.with_borrow_mut(|scratch| self.project_one(i, x, nb, dp, out, scratch))
+        };
+        projections.par_iter_mut().enumerate().for_each(|(i, out)| {
+            SCRATCH.with_borrow_mut(|scratch| {
+                // Corrections written here are dropped; the buffer only grows.
+                let mut dp = std::mem::take(&mut scratch.dp);
+                let members = nb.fluid.count(i) + 1;
+                if dp.len() < members {
+                    dp.resize(members, Vec3::zeros());
+                }
+                self.project_one(i, x, nb, &mut dp[..members], out, scratch);
+                scratch.dp = dp;
+            })
+        });
+
+        let c = corrections;
+        c.owners.clear();
+        c.owners.extend(
+            (0..projections.len() as u32).filter(|&i| projections[i as usize].materialized),
         );
+        c.offsets.clear();
+        c.offsets.push(0);
+        for &i in &c.owners {
+            let start = *c.offsets.last().unwrap_or(&0);
+            projections[i as usize].segment = start;
+            c.offsets
+                .push(start + nb.fluid.count(i as usize) as u32 + 1);
+        }
+        c.data.clear();
+        c.data
+            .resize(*c.offsets.last().unwrap_or(&0) as usize, Vec3::zeros());
+        par_segments_zip_mut(&c.offsets, &mut c.data, &mut c.owners, |_, dp, &mut i| {
+            let mut again = Projection::default();
+            project(i as usize, dp, &mut again);
+        });
     }
 
     /// Σ_{i: j∈N̄_j} (P_{i,j} − x_j): the sum of all corrections the local step made to
@@ -255,7 +314,7 @@ impl DensityConstraint {
         x: &[Vec3],
         nb: &Neighborhood,
         projections: &[Projection],
-        corrections: &[Vec3],
+        corrections: &Corrections,
         gather_slots: &[u32],
     ) -> Vec3 {
         let scale = self.weight_of(nb, j) * self.mass / self.rest_density;
@@ -264,7 +323,9 @@ impl DensityConstraint {
         for (k, &i) in nb.fluid.of(j).iter().enumerate() {
             let p = &projections[i as usize];
             if p.materialized {
-                sum += corrections[gather_slots[first + k] as usize];
+                // The slot in i's full stencil, moved to i's segment.
+                let member = gather_slots[first + k] - nb.stencil_offsets[i as usize];
+                sum += corrections.data[(p.segment + member) as usize];
             } else if p.lambda != 0.0 {
                 // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).
                 sum += self.kernel.grad_w(&(x[j] - x[i as usize])) * (p.lambda * scale);

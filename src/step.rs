@@ -2,7 +2,7 @@
 //! global solves (with Chebyshev extrapolation) until the displacement rule stops, update
 //! velocities, apply XSPH, and choose the next step size by the CFL rule (§8).
 
-use crate::constraint::{Neighborhood, Projection};
+use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists};
 use crate::params::SolverKind;
 use crate::solver::DiagonalSystem;
@@ -24,8 +24,8 @@ pub(crate) struct StepBuffers {
     rhs: Vec<Vec3>,
     /// Local-step results per constraint.
     projections: Vec<Projection>,
-    /// Corrections P_{i,j} − X_j of multi-step projections, laid out by stencil (m).
-    corrections: Vec<Vec3>,
+    /// Corrections P_{i,j} − X_j of multi-step projections (m).
+    corrections: Corrections,
     order: Vec<u32>,
     table: CellTable,
     fluid_lists: NeighborLists,

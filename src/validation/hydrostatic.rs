@@ -13,7 +13,7 @@
 //! whether the constraints carry the weight of the water the way a pressure field would.
 
 use crate::boundary::Aabb;
-use crate::constraint::{Neighborhood, Projection};
+use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use crate::plot::{LineChart, Series, SeriesStyle};
 use crate::{Error, Params, ProjectionWeight, SolverKind, Vec3, World};
@@ -352,7 +352,7 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             boundary_psi: &psi,
             stencil_offsets: &stencil_offsets,
         };
-        let (mut projections, mut corrections) = (Vec::<Projection>::new(), Vec::new());
+        let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
         world
             .constraint
             .project(&x, &nb, &mut projections, &mut corrections);

@@ -26,21 +26,6 @@ pub struct Neighborhood<'a> {
     pub boundary_positions: &'a [Vec3],
     /// Boundary particle masses ψ_b (kg).
     pub boundary_psi: &'a [f64],
-    /// Start of each particle's stencil segment, `fluid.offsets[i] + i`; one extra entry.
-    pub stencil_offsets: &'a [u32],
-}
-
-impl Neighborhood<'_> {
-    /// Total length of a stencil buffer: one slot per particle and one per fluid pair.
-    pub fn stencil_len(&self) -> usize {
-        self.fluid.indices.len() + self.fluid.len()
-    }
-
-    /// Fills `out` with the stencil offsets `fluid.offsets[i] + i` of `lists`.
-    pub fn stencil_offsets_of(lists: &NeighborLists, out: &mut Vec<u32>) {
-        out.clear();
-        out.extend(lists.offsets.iter().enumerate().map(|(i, &o)| o + i as u32));
-    }
 }
 
 /// The fluid density constraint with the constants of the local projection.
@@ -88,18 +73,6 @@ pub struct Corrections {
     /// Segment k spans `data[offsets[k]..offsets[k + 1]]`.
     offsets: Vec<u32>,
     data: Vec<Vec3>,
-}
-
-impl Corrections {
-    /// Number of stored corrections (one per member of every multi-step projection).
-    pub fn len(&self) -> usize {
-        self.data.len()
-    }
-
-    /// Whether no projection of the last local step took more than one step.
-    pub fn is_empty(&self) -> bool {
-        self.data.is_empty()
-    }
 }
 
 /// Per-thread buffers of one projection: its corrections when they are not kept; the offsets x_i − x_j (m) and their lengths of the
@@ -323,8 +296,8 @@ impl DensityConstraint {
         for (k, &i) in nb.fluid.of(j).iter().enumerate() {
             let p = &projections[i as usize];
             if p.materialized {
-                // The slot in i's full stencil, moved to i's segment.
-                let member = gather_slots[first + k] - nb.stencil_offsets[i as usize];
+                // j's place in i's list, after i's own correction at the segment's start.
+                let member = gather_slots[first + k] - nb.fluid.offsets[i as usize] + 1;
                 sum += corrections.data[(p.segment + member) as usize];
             } else if p.lambda != 0.0 {
                 // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).

@@ -30,9 +30,8 @@ pub(crate) struct StepBuffers {
     table: CellTable,
     fluid_lists: NeighborLists,
     boundary_lists: NeighborLists,
-    /// For pair slot k of particle j (neighbour i): where i's stencil keeps its correction of j.
+    /// For pair slot k of particle j (neighbour i): the slot of j in i's list (`reverse_slots`).
     gather_slots: Vec<u32>,
-    stencil_offsets: Vec<u32>,
     system: DiagonalSystem,
     scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
@@ -145,12 +144,6 @@ impl World {
                 &mut b.boundary_lists,
             );
             b.fluid_lists.reverse_slots(&mut b.gather_slots);
-            let indices = &b.fluid_lists.indices;
-            b.gather_slots
-                .par_iter_mut()
-                .zip(indices.par_iter())
-                .for_each(|(g, &i)| *g += i + 1);
-            Neighborhood::stencil_offsets_of(&b.fluid_lists, &mut b.stencil_offsets);
             timings.neighbors = started.elapsed().as_secs_f64();
 
             // 3. The system matrix of formulation F1, frozen for the step.
@@ -175,7 +168,6 @@ impl World {
                 boundary: &b.boundary_lists,
                 boundary_positions: &boundary.positions,
                 boundary_psi: &boundary.psi,
-                stencil_offsets: &b.stencil_offsets,
             };
             chebyshev.reset();
             let chebyshev_step = params.solver == SolverKind::Chebyshev;

@@ -343,14 +343,11 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             (NeighborLists::default(), NeighborLists::default());
         grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
         grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
-        let mut stencil_offsets = Vec::new();
-        Neighborhood::stencil_offsets_of(&fluid_lists, &mut stencil_offsets);
         let nb = Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,
             boundary_positions: &bx,
             boundary_psi: &psi,
-            stencil_offsets: &stencil_offsets,
         };
         let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
         world
@@ -361,9 +358,6 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         // step gathers it.
         let mut slots = Vec::new();
         fluid_lists.reverse_slots(&mut slots);
-        for (slot, &i) in slots.iter_mut().zip(&fluid_lists.indices) {
-            *slot += i + 1;
-        }
         let c = &world.constraint;
         let force_sum: f64 = (0..x.len())
             .map(|j| {

@@ -75,6 +75,13 @@ pub struct Corrections {
     data: Vec<Vec3>,
 }
 
+impl Corrections {
+    /// How many projections of the last local step kept their corrections.
+    pub fn kept(&self) -> usize {
+        self.owners.len()
+    }
+}
+
 /// Per-thread buffers of one projection: its corrections when they are not kept; the offsets x_i − x_j (m) and their lengths of the
 /// first density evaluation, fluid and boundary members in stencil order (boundary ones with
 /// their ψ_b, kg), reused by the first gradient evaluation and the density after the first

@@ -247,9 +247,6 @@ impl DensityConstraint {
         corrections: &mut Corrections,
     ) {
         projections.resize(x.len(), Projection::default());
-        let project = |i: usize, dp: &mut [Vec3], out: &mut Projection| {
-            SCRATCH.with_borrow_mut(|scratch| self.project_one(i, x, nb, dp, out, scratch))
-        };
         projections.par_iter_mut().enumerate().for_each(|(i, out)| {
             SCRATCH.with_borrow_mut(|scratch| {
                 // Corrections written here are dropped; the buffer only grows.
@@ -281,7 +278,9 @@ impl DensityConstraint {
             .resize(*c.offsets.last().unwrap_or(&0) as usize, Vec3::zeros());
         par_segments_zip_mut(&c.offsets, &mut c.data, &mut c.owners, |_, dp, &mut i| {
             let mut again = Projection::default();
-            project(i as usize, dp, &mut again);
+            SCRATCH.with_borrow_mut(|scratch| {
+                self.project_one(i as usize, x, nb, dp, &mut again, scratch)
+            });
         });
     }
 

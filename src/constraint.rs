@@ -82,18 +82,74 @@ impl Corrections {
     }
 }
 
-/// Per-thread buffers of one projection: its corrections when they are not kept; the offsets x_i − x_j (m) and their lengths of the
-/// first density evaluation, fluid and boundary members in stencil order (boundary ones with
-/// their ψ_b, kg), reused by the first gradient evaluation and the density after the first
-/// step; the gradients of the current step; and the fluid members' weights w_j.
+/// Per-thread buffers of one projection: its corrections when they are not kept; its fluid
+/// members at the iterate ([`Members`]) and its boundary members (offset x_i − x_b in m, its
+/// length, ψ_b in kg), both kept by the first density evaluation for the first gradient
+/// evaluation and the density after the first step; and the gradients of a later step.
 #[derive(Default)]
 struct Scratch {
     /// The stencil corrections of a projection whose segment is not kept.
     dp: Vec<Vec3>,
-    fluid: Vec<(Vec3, f64)>,
+    members: Members,
     boundary: Vec<(Vec3, f64, f64)>,
     grads: Vec<Vec3>,
+}
+
+/// The fluid members of one stencil, in stencil order and by component (a structure of
+/// arrays, so that the loops over them vectorise): offsets r = x_i − x_j (m) and their
+/// lengths (m); the gradients ∇_{x_j}C_i (1/m) and weights w_j of the first step; and one
+/// value per member (kernel values or squared gradients) for [`ordered_sum`].
+#[derive(Default)]
+struct Members {
+    rx: Vec<f64>,
+    ry: Vec<f64>,
+    rz: Vec<f64>,
+    len: Vec<f64>,
+    gx: Vec<f64>,
+    gy: Vec<f64>,
+    gz: Vec<f64>,
     weights: Vec<f64>,
+    values: Vec<f64>,
+}
+
+impl Members {
+    /// Sizes every array for `n` members.
+    fn resize(&mut self, n: usize) {
+        for v in [
+            &mut self.rx,
+            &mut self.ry,
+            &mut self.rz,
+            &mut self.len,
+            &mut self.gx,
+            &mut self.gy,
+            &mut self.gz,
+            &mut self.weights,
+            &mut self.values,
+        ] {
+            v.resize(n, 0.0);
+        }
+    }
+
+    /// ∇_{x_j}C_i of the s-th member (1/m).
+    #[inline]
+    fn gradient(&self, s: usize) -> Vec3 {
+        Vec3::new(self.gx[s], self.gy[s], self.gz[s])
+    }
+}
+
+/// The sum of `values` in one fixed order, in four interleaved partial sums (so that it
+/// vectorises and does not wait on one addition after another).
+#[inline]
+fn ordered_sum(values: &[f64]) -> f64 {
+    let mut partial = [0.0; 4];
+    let chunks = values.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().sum();
+    for chunk in chunks {
+        for (p, v) in partial.iter_mut().zip(chunk) {
+            *p += v;
+        }
+    }
+    (partial[0] + partial[1]) + (partial[2] + partial[3]) + rest
 }
 
 thread_local! {
@@ -127,8 +183,8 @@ impl DensityConstraint {
     }
 
     /// [`Self::density_at`] at the iterate (`xi` = x_i, neighbours at `x`), keeping every
-    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. Same result,
-    /// bit for bit.
+    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. The same
+    /// density up to the order of the summation.
     #[inline]
     fn first_density(
         &self,
@@ -139,15 +195,31 @@ impl DensityConstraint {
         scratch: &mut Scratch,
     ) -> f64 {
         let k = &self.kernel;
-        scratch.fluid.clear();
-        scratch.boundary.clear();
-        let mut fluid = 0.0;
-        for &j in nb.fluid.of(i) {
-            let r = xi - x[j as usize];
-            let len = r.norm();
-            fluid += k.w(len);
-            scratch.fluid.push((r, len));
+        let neighbors = nb.fluid.of(i);
+        let m = &mut scratch.members;
+        m.resize(neighbors.len());
+        for (((&j, rx), ry), rz) in neighbors
+            .iter()
+            .zip(&mut m.rx)
+            .zip(&mut m.ry)
+            .zip(&mut m.rz)
+        {
+            let xj = &x[j as usize];
+            (*rx, *ry, *rz) = (xi.x - xj.x, xi.y - xj.y, xi.z - xj.z);
         }
+        for ((((len, w), rx), ry), rz) in m
+            .len
+            .iter_mut()
+            .zip(&mut m.values)
+            .zip(&m.rx)
+            .zip(&m.ry)
+            .zip(&m.rz)
+        {
+            *len = (rx * rx + ry * ry + rz * rz).sqrt();
+            *w = k.w(*len);
+        }
+        let fluid = ordered_sum(&m.values);
+        scratch.boundary.clear();
         let mut boundary = 0.0;
         for &b in nb.boundary.of(i) {
             let b = b as usize;
@@ -159,44 +231,68 @@ impl DensityConstraint {
         self.mass * (k.w_zero() + fluid) + boundary
     }
 
-    /// [`Self::gradients`] at the iterate, from the offsets [`Self::first_density`] kept.
+    /// [`Self::gradients`] at the iterate, from the offsets [`Self::first_density`] kept;
+    /// the members' gradients and weights are left in `scratch.members`.
     #[inline]
     fn first_gradients(&self, i: usize, nb: &Neighborhood, scratch: &mut Scratch) -> (Vec3, f64) {
         let kernel = &self.kernel;
         let scale = self.mass / self.rest_density;
-        let mut grad_i: Vec3 = scratch
+        let boundary: Vec3 = scratch
             .boundary
             .iter()
             .map(|(r, len, psi)| kernel.grad_w_at(r, *len) * *psi)
             .sum::<Vec3>()
             / self.rest_density;
-        let mut denominator = 0.0;
-        scratch.grads.clear();
-        scratch.weights.clear();
-        for ((r, len), &j) in scratch.fluid.iter().zip(nb.fluid.of(i)) {
-            let g = kernel.grad_w_at(r, *len) * scale;
-            grad_i += g;
-            denominator += g.norm_squared();
-            scratch.grads.push(-g);
-            scratch.weights.push(self.weight_of(nb, j as usize));
+        let m = &mut scratch.members;
+        for ((((((gx, gy), gz), g2), rx), ry), (rz, len)) in
+            m.gx.iter_mut()
+                .zip(&mut m.gy)
+                .zip(&mut m.gz)
+                .zip(&mut m.values)
+                .zip(&m.rx)
+                .zip(&m.ry)
+                .zip(m.rz.iter().zip(&m.len))
+        {
+            // ∇_{x_j}C_i = −(m/ρ0)∇W(x_i − x_j).
+            let c = -kernel.grad_w_coefficient(*len) * scale;
+            (*gx, *gy, *gz) = (rx * c, ry * c, rz * c);
+            *g2 = *gx * *gx + *gy * *gy + *gz * *gz;
         }
-        (grad_i, denominator + grad_i.norm_squared())
+        for (w, &j) in m.weights.iter_mut().zip(nb.fluid.of(i)) {
+            *w = self.weight_of(nb, j as usize);
+        }
+        let fluid = Vec3::new(ordered_sum(&m.gx), ordered_sum(&m.gy), ordered_sum(&m.gz));
+        let grad_i = boundary - fluid;
+        (grad_i, ordered_sum(&m.values) + grad_i.norm_squared())
     }
 
     /// ρ_i after the first projection step `first` (λ and the centre's correction), from the
     /// offsets kept by [`Self::first_density`] and the gradients and weights of
     /// [`Self::first_gradients`]: p_i − p_j = (x_i − x_j) + Δp_i − λ w_j ∇_{x_j}C_i.
     #[inline]
-    fn first_step_density(&self, first: &Projection, scratch: &Scratch) -> f64 {
+    fn first_step_density(&self, first: &Projection, scratch: &mut Scratch) -> f64 {
         let k = &self.kernel;
         let (lambda, shift) = (first.lambda, first.self_correction);
-        let fluid: f64 = scratch
-            .fluid
-            .iter()
-            .zip(&scratch.grads)
-            .zip(&scratch.weights)
-            .map(|(((r, _), g), w)| k.w((r + shift - g * (lambda * w)).norm()))
-            .sum();
+        let m = &mut scratch.members;
+        for ((((((w, weight), gx), gy), gz), rx), (ry, rz)) in m
+            .values
+            .iter_mut()
+            .zip(&m.weights)
+            .zip(&m.gx)
+            .zip(&m.gy)
+            .zip(&m.gz)
+            .zip(&m.rx)
+            .zip(m.ry.iter().zip(&m.rz))
+        {
+            let f = lambda * weight;
+            let (dx, dy, dz) = (
+                rx + shift.x - gx * f,
+                ry + shift.y - gy * f,
+                rz + shift.z - gz * f,
+            );
+            *w = k.w((dx * dx + dy * dy + dz * dz).sqrt());
+        }
+        let fluid = ordered_sum(&m.values);
         let boundary: f64 = scratch
             .boundary
             .iter()
@@ -377,8 +473,9 @@ impl DensityConstraint {
             if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
                 // A second step is needed (or requested): write the first step's corrections out.
                 dp[0] = out.self_correction;
-                for (s, (g, w)) in scratch.grads.iter().zip(&scratch.weights).enumerate() {
-                    dp[s + 1] = g * (out.lambda * w);
+                let m = &scratch.members;
+                for (s, w) in m.weights.iter().enumerate() {
+                    dp[s + 1] = m.gradient(s) * (out.lambda * w);
                 }
                 materialized = true;
             }

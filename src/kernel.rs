@@ -12,6 +12,8 @@ const GRADIENT_CUTOFF: f64 = 1e-9;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CubicKernel {
     support_radius: f64,
+    /// 1/H, in 1/m.
+    inverse_support: f64,
     /// Normalisation σ = 8/(πH³), in 1/m³; also W(0).
     sigma: f64,
     /// 48/(πH⁴), the gradient's prefactor, in 1/m⁴.
@@ -24,6 +26,7 @@ impl CubicKernel {
         let h3 = support_radius.powi(3);
         Self {
             support_radius,
+            inverse_support: 1.0 / support_radius,
             sigma: 8.0 / (PI * h3),
             gradient_factor: 48.0 / (PI * h3 * support_radius),
         }
@@ -40,17 +43,17 @@ impl CubicKernel {
     }
 
     /// W at distance `r` (metres), in 1/m³.
+    ///
+    /// Evaluated without branches as σ·(2·(1 − q)₊³ − 8·(½ − q)₊³), q = r/H, which is
+    /// σ·(6q³ − 6q² + 1) for q ≤ ½ and σ·2(1 − q)³ for ½ < q ≤ 1: the neighbours of a
+    /// particle fall on both sides of q = ½ in no predictable order, and this is the inner
+    /// loop of every density evaluation.
     #[inline]
     pub fn w(&self, r: f64) -> f64 {
-        let q = r / self.support_radius;
-        if q <= 0.5 {
-            self.sigma * (6.0 * q * q * (q - 1.0) + 1.0)
-        } else if q <= 1.0 {
-            let t = 1.0 - q;
-            self.sigma * 2.0 * t * t * t
-        } else {
-            0.0
-        }
+        let q = r * self.inverse_support;
+        let outer = (1.0 - q).max(0.0);
+        let inner = (0.5 - q).max(0.0);
+        self.sigma * (2.0 * outer * outer * outer - 8.0 * inner * inner * inner)
     }
 
     /// ∇W with respect to the first argument of W(x_i − x_j), given `r = x_i − x_j` (metres),
@@ -62,18 +65,24 @@ impl CubicKernel {
 
     /// [`CubicKernel::grad_w`] for `r` whose length `len` = |r| (m) is already known.
     #[inline]
+    ///
+    /// The shape q(3q − 2) for q ≤ ½ and −(1 − q)² for ½ < q ≤ 1 is evaluated without
+    /// branches as 4·(½ − q)₊² − (1 − q)₊², as in [`CubicKernel::w`].
     pub fn grad_w_at(&self, r: &Vec3, len: f64) -> Vec3 {
-        let q = len / self.support_radius;
-        if len <= GRADIENT_CUTOFF || q > 1.0 {
-            return Vec3::zeros();
-        }
-        let shape = if q <= 0.5 {
-            q * (3.0 * q - 2.0)
-        } else {
-            let t = 1.0 - q;
-            -t * t
-        };
-        r * (self.gradient_factor * shape / len)
+        r * self.grad_w_coefficient(len)
+    }
+
+    /// The factor c with ∇W(r) = c·r for an offset of length `len` (m), in 1/m⁵: zero at
+    /// or below the cutoff and beyond H. Written as a select, so loops over many lengths
+    /// vectorise.
+    #[inline]
+    pub fn grad_w_coefficient(&self, len: f64) -> f64 {
+        let q = len * self.inverse_support;
+        let outer = (1.0 - q).max(0.0);
+        let inner = (0.5 - q).max(0.0);
+        let shape = 4.0 * inner * inner - outer * outer;
+        let c = self.gradient_factor * shape / len;
+        if len > GRADIENT_CUTOFF { c } else { 0.0 }
     }
 }
 

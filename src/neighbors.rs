@@ -179,26 +179,39 @@ impl UniformGrid {
                 found.clear();
                 let first = b * BLOCK;
                 let end = (first + BLOCK).min(queries.len());
+                // The neighbour cells of the previous query's cell, in ascending Z-rank, so
+                // that their slot ranges come in ascending order and no list needs sorting.
+                let mut cached: Option<[usize; 3]> = None;
+                let mut ranges: Vec<std::ops::Range<u32>> = Vec::with_capacity(27);
                 for (i, &q) in queries.iter().enumerate().take(end).skip(first) {
                     let start = found.len();
                     let c = self.cell_of(&q);
-                    for z in c[2].saturating_sub(1)..=(c[2] + 1).min(self.dims[2] - 1) {
-                        for y in c[1].saturating_sub(1)..=(c[1] + 1).min(self.dims[1] - 1) {
-                            for x in c[0].saturating_sub(1)..=(c[0] + 1).min(self.dims[0] - 1) {
-                                let rank = self.rank([x, y, z]);
-                                let range = table.cell_start[rank]..table.cell_start[rank + 1];
-                                for j in range {
-                                    if exclude_self && j as usize == i {
-                                        continue;
-                                    }
-                                    if (points[j as usize] - q).norm_squared() <= r2 {
-                                        found.push(j);
-                                    }
+                    if cached != Some(c) {
+                        cached = Some(c);
+                        ranges.clear();
+                        for z in c[2].saturating_sub(1)..=(c[2] + 1).min(self.dims[2] - 1) {
+                            for y in c[1].saturating_sub(1)..=(c[1] + 1).min(self.dims[1] - 1) {
+                                for x in c[0].saturating_sub(1)..=(c[0] + 1).min(self.dims[0] - 1) {
+                                    let rank = self.rank([x, y, z]);
+                                    ranges.push(table.cell_start[rank]..table.cell_start[rank + 1]);
                                 }
                             }
                         }
+                        ranges.sort_unstable_by_key(|r| r.start);
                     }
-                    found[start..].sort_unstable();
+                    // Every candidate is written; the count advances only for those within
+                    // the radius (no branch on the distance test).
+                    let candidates: usize = ranges.iter().map(|r| r.len()).sum();
+                    found.resize(start + candidates, 0);
+                    let mut n = start;
+                    for range in &ranges {
+                        for j in range.clone() {
+                            found[n] = j;
+                            let close = (points[j as usize] - q).norm_squared() <= r2;
+                            n += usize::from(close && !(exclude_self && j as usize == i));
+                        }
+                    }
+                    found.truncate(n);
                     counts.push((found.len() - start) as u32);
                 }
             });

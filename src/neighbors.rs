@@ -284,17 +284,25 @@ impl NeighborLists {
 
     /// For symmetric lists (i lists j exactly when j lists i): for every pair slot k of query
     /// i pointing to j, the slot of i inside j's list.
+    ///
+    /// One pass over the pairs in query order with a cursor per list: j's list is ascending,
+    /// so the queries that list j reach it in the order they appear in its list, and the
+    /// cursor of j stands at i's place when query i reaches j (no search).
     pub fn reverse_slots(&self, reverse: &mut Vec<u32>) {
         reverse.resize(self.indices.len(), 0);
-        par_segments_mut(&self.offsets, reverse, |i, slots| {
-            for (slot, &j) in slots.iter_mut().zip(self.of(i)) {
-                let theirs = self.of(j as usize);
-                let at = theirs
-                    .binary_search(&(i as u32))
-                    .expect("neighbour lists are symmetric");
-                *slot = self.offsets[j as usize] + at as u32;
+        let mut cursors = self.offsets[..self.len()].to_vec();
+        for i in 0..self.len() {
+            let range = self.offsets[i] as usize..self.offsets[i + 1] as usize;
+            for (slot, &j) in reverse[range.clone()].iter_mut().zip(&self.indices[range]) {
+                let cursor = &mut cursors[j as usize];
+                assert!(
+                    self.indices.get(*cursor as usize) == Some(&(i as u32)),
+                    "neighbour lists are symmetric"
+                );
+                *slot = *cursor;
+                *cursor += 1;
             }
-        });
+        }
     }
 }
 

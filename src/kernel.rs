@@ -64,10 +64,10 @@ impl CubicKernel {
     }
 
     /// [`CubicKernel::grad_w`] for `r` whose length `len` = |r| (m) is already known.
-    #[inline]
     ///
     /// The shape q(3q − 2) for q ≤ ½ and −(1 − q)² for ½ < q ≤ 1 is evaluated without
     /// branches as 4·(½ − q)₊² − (1 − q)₊², as in [`CubicKernel::w`].
+    #[inline]
     pub fn grad_w_at(&self, r: &Vec3, len: f64) -> Vec3 {
         r * self.grad_w_coefficient(len)
     }
@@ -137,6 +137,37 @@ mod tests {
         assert_eq!(kernel.w(0.1000001), 0.0);
         // Continuous at q = 1/2: both branches give σ/4.
         assert!((kernel.w(0.05) - kernel.w_zero() / 4.0).abs() < 1e-9);
+    }
+
+    /// The branch-free forms equal the piecewise definitions of ALGORITHM.md §2.1, on both
+    /// sides of q = ½, at q = ½ and 1 exactly, and beyond the support.
+    #[test]
+    fn branch_free_forms_match_the_piecewise_spline() {
+        let h = 0.1;
+        let k = CubicKernel::new(h);
+        let sigma = 8.0 / (PI * h * h * h);
+        for step in 0..=1300 {
+            let q = step as f64 / 1000.0;
+            let (w, shape) = if q <= 0.5 {
+                (6.0 * q * q * q - 6.0 * q * q + 1.0, q * (3.0 * q - 2.0))
+            } else if q <= 1.0 {
+                (2.0 * (1.0 - q).powi(3), -(1.0 - q).powi(2))
+            } else {
+                (0.0, 0.0)
+            };
+            let r = q * h;
+            assert!((k.w(r) - sigma * w).abs() <= 1e-12 * sigma, "W at q = {q}");
+            let grad = k.grad_w_at(&Vec3::new(r, 0.0, 0.0), r).x;
+            let expected = if step == 0 {
+                0.0
+            } else {
+                48.0 / (PI * h.powi(4)) * shape
+            };
+            assert!(
+                (grad - expected).abs() <= 1e-10 * 48.0 / (PI * h.powi(4)),
+                "∇W at q = {q}: {grad} against {expected}"
+            );
+        }
     }
 
     #[test]

@@ -306,16 +306,6 @@ impl NeighborLists {
     }
 }
 
-/// Runs `f(i, segment_i)` in parallel over the CSR segments `data[offsets[i]..offsets[i + 1]]`.
-pub fn par_segments_mut<T: Send>(
-    offsets: &[u32],
-    data: &mut [T],
-    f: impl Fn(usize, &mut [T]) + Sync,
-) {
-    let mut unit = vec![(); offsets.len().saturating_sub(1)];
-    par_segments_zip_mut(offsets, data, &mut unit, |i, segment, _| f(i, segment));
-}
-
 /// Runs `f(i, segment_i, &mut items[i])` in parallel over the CSR segments
 /// `data[offsets[i]..offsets[i + 1]]` together with one item per segment.
 pub fn par_segments_zip_mut<T: Send, U: Send>(

@@ -257,6 +257,8 @@ pub struct NeighborLists {
     /// Neighbour indices, concatenated.
     pub indices: Vec<u32>,
     scratch: Vec<(Vec<u32>, Vec<u32>)>,
+    /// Scratch of [`NeighborLists::reverse_slots`]: the next slot of every list.
+    cursors: Vec<u32>,
 }
 
 impl NeighborLists {
@@ -288,9 +290,11 @@ impl NeighborLists {
     /// One pass over the pairs in query order with a cursor per list: j's list is ascending,
     /// so the queries that list j reach it in the order they appear in its list, and the
     /// cursor of j stands at i's place when query i reaches j (no search).
-    pub fn reverse_slots(&self, reverse: &mut Vec<u32>) {
+    pub fn reverse_slots(&mut self, reverse: &mut Vec<u32>) {
         reverse.resize(self.indices.len(), 0);
-        let mut cursors = self.offsets[..self.len()].to_vec();
+        let mut cursors = std::mem::take(&mut self.cursors);
+        cursors.clear();
+        cursors.extend_from_slice(&self.offsets[..self.len()]);
         for i in 0..self.len() {
             let range = self.offsets[i] as usize..self.offsets[i + 1] as usize;
             for (slot, &j) in reverse[range.clone()].iter_mut().zip(&self.indices[range]) {
@@ -303,6 +307,7 @@ impl NeighborLists {
                 *cursor += 1;
             }
         }
+        self.cursors = cursors;
     }
 }
 

@@ -343,6 +343,8 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             (NeighborLists::default(), NeighborLists::default());
         grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
         grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
+        let mut slots = Vec::new();
+        fluid_lists.reverse_slots(&mut slots);
         let nb = Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,
@@ -356,8 +358,6 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         let volume = world.constraint.mass / world.constraint.rest_density;
         // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
         // step gathers it.
-        let mut slots = Vec::new();
-        fluid_lists.reverse_slots(&mut slots);
         let c = &world.constraint;
         let force_sum: f64 = (0..x.len())
             .map(|j| {

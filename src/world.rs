@@ -79,6 +79,7 @@ impl World {
                 weight: params.projection_weight,
                 rest_stencil_size: params.rest_stencil_size(),
                 materialize_all: false,
+                portable: false,
             },
             pool,
             fluid: Fluid::default(),

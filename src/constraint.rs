@@ -76,6 +76,11 @@ pub struct Corrections {
     /// Segment k spans `data[offsets[k]..offsets[k + 1]]`.
     offsets: Vec<u32>,
     data: Vec<Vec3>,
+    /// λ_i of every projection and whether it kept a segment, in two compact arrays: the
+    /// gather reads them for every neighbour, and the full [`Projection`]s are five times
+    /// larger.
+    lambdas: Vec<f64>,
+    kept: Vec<bool>,
 }
 
 impl Corrections {
@@ -360,6 +365,12 @@ impl DensityConstraint {
         });
 
         let c = corrections;
+        c.lambdas.resize(projections.len(), 0.0);
+        c.kept.resize(projections.len(), false);
+        (&mut c.lambdas, &mut c.kept)
+            .into_par_iter()
+            .zip(projections.par_iter())
+            .for_each(|((lambda, kept), p)| (*lambda, *kept) = (p.lambda, p.materialized));
         c.owners.clear();
         c.owners.extend(
             (0..projections.len() as u32).filter(|&i| projections[i as usize].materialized),
@@ -399,14 +410,14 @@ impl DensityConstraint {
         let first = nb.fluid.offsets[j] as usize;
         let mut sum = projections[j].self_correction;
         for (k, &i) in nb.fluid.of(j).iter().enumerate() {
-            let p = &projections[i as usize];
-            if p.materialized {
+            let (i, lambda) = (i as usize, corrections.lambdas[i as usize]);
+            if corrections.kept[i] {
                 // j's place in i's list, after i's own correction at the segment's start.
-                let member = gather_slots[first + k] - nb.fluid.offsets[i as usize] + 1;
-                sum += corrections.data[(p.segment + member) as usize];
-            } else if p.lambda != 0.0 {
+                let member = gather_slots[first + k] - nb.fluid.offsets[i] + 1;
+                sum += corrections.data[(projections[i].segment + member) as usize];
+            } else if lambda != 0.0 {
                 // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).
-                sum += self.kernel.grad_w(&(x[j] - x[i as usize])) * (p.lambda * scale);
+                sum += self.kernel.grad_w(&(x[j] - x[i])) * (lambda * scale);
             }
         }
         sum

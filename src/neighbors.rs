@@ -334,7 +334,7 @@ impl Coordinates {
             .enumerate()
         {
             out.clear();
-            out.extend(points.iter().map(|p| p[axis]));
+            out.par_extend(points.par_iter().map(|p| p[axis]));
         }
     }
 }

@@ -7,6 +7,7 @@
 //! `DELAY` override the viscosity, Δt_max, stiffness and Chebyshev's γ and delay;
 //! `WEIGHT=uniform|unit` the projection weighting; `FCC=1` fills the tank with a face-centred
 //! cubic packing at rest density (wall gap `FCCGAP`, m) instead of the cubic lattice;
+//! `MINIT`, `MAXIT` set the least and most outer iterations per step (equal: a fixed count);
 //! `LAYERS`, `DISP`, `DUMP` print velocity by region, displacement per initial layer and the
 //! last step's δ_k; `NY` sets the column's height in particles (default 16).
 use projfluid::{boundary::Aabb, *};
@@ -45,6 +46,12 @@ fn main() {
     }
     if let Ok(v) = std::env::var("K") {
         params.stiffness = v.parse().unwrap();
+    }
+    if let Ok(v) = std::env::var("MINIT") {
+        params.min_outer_iterations = v.parse().unwrap();
+    }
+    if let Ok(v) = std::env::var("MAXIT") {
+        params.max_outer_iterations = v.parse().unwrap();
     }
     params.displacement_tolerance = tau_r * params.particle_radius;
     let (r, d) = (params.particle_radius, params.spacing());

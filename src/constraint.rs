@@ -13,6 +13,10 @@ const CONSTRAINT_GOAL: f64 = 1e-14;
 const MAX_PROJECTION_STEPS: usize = 100;
 /// Regularisation ε of λ = −C/(|∇C|² + ε), in m⁻².
 const REGULARIZATION: f64 = 1e-6;
+/// The bound on ρ_i after a first projection step must stay this far (relative to ρ0) below
+/// ρ0 for the step's density to go unevaluated: far more than the round-off of either
+/// evaluation (≈ 10⁻¹⁴).
+const RELAXATION_MARGIN: f64 = 1e-9;
 
 /// Everything a constraint reads during one time step: the fluid's neighbour lists and the
 /// static boundary particles with their Akinci masses ψ_b = ρ0·V_b (kg).
@@ -48,6 +52,9 @@ pub struct DensityConstraint {
     /// Project with the portable build even where the processor has AVX2 (for the test
     /// that both builds agree bit for bit).
     pub portable: bool,
+    /// Evaluate ρ_i after every first projection step, also where a bound already shows it
+    /// is below ρ0 (for the test that skipping those evaluations changes nothing).
+    pub evaluate_first_step: bool,
 }
 
 /// What the local step of one constraint produced.
@@ -309,6 +316,46 @@ impl DensityConstraint {
         self.mass * (k.w_zero() + fluid) + boundary
     }
 
+    /// Whether the first projection step (λ, with the centre's weight `w_i` and gradient
+    /// `grad_i`) surely leaves ρ_i at or below ρ0, so that the density after it need not be
+    /// evaluated: then the projection ends after that step whatever the evaluation would
+    /// give, and skipping it changes no bit of the result. `rho` is ρ_i at the iterate;
+    /// `scratch` holds the members' |∇_{x_j}C_i|² (overwritten here) and weights from
+    /// [`Self::first_gradients`], and the boundary members from [`Self::first_density`].
+    ///
+    /// The step moves p_i by Δ_i = λw_i∇_{x_i}C_i and member j by Δ_j = λw_j∇_{x_j}C_i.
+    /// With W(r + δ) ≤ W(r) + ∇W(r)·δ + ½M|δ|² ([`CubicKernel::curvature_bound`]) the new
+    /// density is at most ρ_i + ρ0·λ·(w_i|∇_{x_i}C_i|² + Σ_j w_j|∇_{x_j}C_i|²) (the linear
+    /// change, negative) + ½M·(m·Σ_j 2(|Δ_i|² + |Δ_j|²) + Σ_b ψ_b|Δ_i|²). The weighted
+    /// step overshoots the linear target by about n̄ + 1, so the bound holds for every
+    /// compression below ≈ 10 %: nearly every projection of a flow.
+    #[inline(always)]
+    fn first_step_surely_relaxes(
+        &self,
+        rho: f64,
+        lambda: f64,
+        grad_i: Vec3,
+        w_i: f64,
+        scratch: &mut Scratch,
+    ) -> bool {
+        let m = &mut scratch.members;
+        for (v, w) in m.values.iter_mut().zip(&m.weights) {
+            *v *= w;
+        }
+        let weighted = ordered_sum(&m.values);
+        for (v, w) in m.values.iter_mut().zip(&m.weights) {
+            *v *= w;
+        }
+        let members_shift = lambda * lambda * ordered_sum(&m.values);
+        let grad_i2 = grad_i.norm_squared();
+        let shift = lambda * lambda * w_i * w_i * grad_i2;
+        let psi: f64 = scratch.boundary.iter().map(|(_, _, psi)| psi).sum();
+        let linear = self.rest_density * lambda * (w_i * grad_i2 + weighted);
+        let spread = 2.0 * self.mass * (m.values.len() as f64 * shift + members_shift);
+        let quadratic = 0.5 * self.kernel.curvature_bound() * (spread + psi * shift);
+        rho + linear + quadratic <= self.rest_density * (1.0 - RELAXATION_MARGIN)
+    }
+
     /// SPH density ρ_i (kg/m³) of every fluid particle at `positions`, written into `out`.
     pub fn densities(&self, positions: &[Vec3], nb: &Neighborhood, out: &mut Vec<f64>) {
         out.resize(positions.len(), 0.0);
@@ -515,7 +562,12 @@ impl DensityConstraint {
         let at = |s: usize| x[members[s] as usize];
         let w = |s: usize| self.weight_of(nb, members[s] as usize);
         let mut materialized = false;
+        let mut relaxes = false;
         for step in 0..MAX_PROJECTION_STEPS {
+            if relaxes {
+                // ρ_i after the first step is surely ≤ ρ0: the projection ends here.
+                break;
+            }
             let pi = x[i] + out.self_correction;
             let rho = match (step, materialized) {
                 (0, _) => self.first_density(i, pi, x, nb, scratch),
@@ -546,7 +598,11 @@ impl DensityConstraint {
                 break;
             }
             let lambda = -c / (denominator + REGULARIZATION);
-            out.self_correction += grad_i * (lambda * self.weight_of(nb, i));
+            let w_i = self.weight_of(nb, i);
+            out.self_correction += grad_i * (lambda * w_i);
+            if step == 0 && !self.evaluate_first_step && !self.materialize_all {
+                relaxes = self.first_step_surely_relaxes(rho, lambda, grad_i, w_i, scratch);
+            }
             if materialized {
                 for (s, g) in scratch.grads.iter().enumerate() {
                     dp[s + 1] += g * (lambda * w(s));
@@ -557,5 +613,120 @@ impl DensityConstraint {
             }
         }
         out.materialized = materialized;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::neighbors::{CellTable, UniformGrid};
+
+    /// A jittered cubic lattice of 7³ particles at `spacing` (m) above a floor of boundary
+    /// particles, searched with radius H; returns (fluid positions, neighbour lists of the
+    /// fluid, of the boundary, boundary positions, ψ).
+    fn cluster(
+        constraint: &DensityConstraint,
+        spacing: f64,
+    ) -> (Vec<Vec3>, NeighborLists, NeighborLists, Vec<Vec3>, Vec<f64>) {
+        let h = constraint.kernel.support_radius();
+        let mut seed = 7u64;
+        let mut jitter = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((seed >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * 0.02 * spacing
+        };
+        let mut fluid = Vec::new();
+        for (i, j, k) in
+            (0..7).flat_map(|i| (0..7).flat_map(move |j| (0..7).map(move |k| (i, j, k))))
+        {
+            let p = Vec3::new(i as f64, j as f64 + 1.0, k as f64) * spacing;
+            fluid.push(p + Vec3::new(jitter(), jitter(), jitter()));
+        }
+        let b = 0.5 * spacing;
+        let boundary: Vec<Vec3> = (-4..18)
+            .flat_map(|i| (-4..18).map(move |k| Vec3::new(i as f64 * b, 0.0, k as f64 * b)))
+            .collect();
+        let psi = vec![constraint.mass / 8.0; boundary.len()];
+        let grid = UniformGrid::covering(Vec3::repeat(-1.0), Vec3::repeat(2.0), h);
+        let sorted = |points: &[Vec3]| {
+            let (mut order, mut table) = (Vec::new(), CellTable::default());
+            grid.sort(points, &mut order, &mut table);
+            let p: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
+            (p, table)
+        };
+        let (x, fluid_table) = sorted(&fluid);
+        let (bx, boundary_table) = sorted(&boundary);
+        let (mut fl, mut bl) = (NeighborLists::default(), NeighborLists::default());
+        grid.search(&fluid_table, &x, &x, h, true, &mut fl);
+        grid.search(&boundary_table, &bx, &x, h, false, &mut bl);
+        (x, fl, bl, bx, psi)
+    }
+
+    /// Where the Taylor bound says the first projection step leaves ρ_i ≤ ρ0, the evaluated
+    /// density after that step is indeed ≤ ρ0. The bound holds for every active constraint
+    /// of a cluster compressed by up to 0.5 % in spacing (1.5 % in density, more than the
+    /// flows' typical compression) and for none at 25 % (where the evaluation still finds
+    /// every step relaxing: the bound is conservative, not wrong).
+    #[test]
+    fn first_step_bound_is_sound_and_effective() {
+        let r = 0.025;
+        let constraint = DensityConstraint {
+            kernel: CubicKernel::new(4.0 * r),
+            mass: 1000.0 * (2.0 * r).powi(3),
+            rest_density: 1000.0,
+            weight: ProjectionWeight::NeighborCount,
+            rest_stencil_size: 4.0 / 3.0 * std::f64::consts::PI * 8.0,
+            materialize_all: false,
+            portable: true,
+            evaluate_first_step: true,
+        };
+        let mut scratch = Scratch::default();
+        for (factor, expected_share) in [
+            (0.9995, 1.0),
+            (0.999, 1.0),
+            (0.998, 1.0),
+            (0.995, 1.0),
+            (0.75, 0.0),
+        ] {
+            let (x, fl, bl, bx, psi) = cluster(&constraint, 2.0 * r * factor);
+            let nb = Neighborhood {
+                fluid: &fl,
+                boundary: &bl,
+                boundary_positions: &bx,
+                boundary_psi: &psi,
+            };
+            let (mut active, mut certified) = (0, 0);
+            for i in 0..x.len() {
+                let rho = constraint.first_density(i, x[i], &x, &nb, &mut scratch);
+                let c = (rho / constraint.rest_density - 1.0).max(0.0);
+                if c <= CONSTRAINT_GOAL {
+                    continue;
+                }
+                active += 1;
+                let (grad_i, denominator) = constraint.first_gradients(i, &nb, &mut scratch);
+                let lambda = -c / (denominator + REGULARIZATION);
+                let w_i = constraint.weight_of(&nb, i);
+                let first = Projection {
+                    lambda,
+                    self_correction: grad_i * (lambda * w_i),
+                    ..Projection::default()
+                };
+                if constraint.first_step_surely_relaxes(rho, lambda, grad_i, w_i, &mut scratch) {
+                    certified += 1;
+                    let after = constraint.first_step_density(&first, &mut scratch);
+                    assert!(
+                        after <= constraint.rest_density,
+                        "spacing factor {factor}, particle {i}: ρ {after} after the step"
+                    );
+                }
+            }
+            assert!(active > 80, "spacing factor {factor}: {active} active");
+            assert_eq!(
+                certified as f64,
+                expected_share * active as f64,
+                "spacing factor {factor}: the bound holds for {certified} of {active}"
+            );
+        }
     }
 }

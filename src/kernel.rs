@@ -56,6 +56,15 @@ impl CubicKernel {
         self.sigma * (2.0 * outer * outer * outer - 8.0 * inner * inner * inner)
     }
 
+    /// The largest curvature of W, in 1/m⁵: a bound M on every eigenvalue of the Hessian of
+    /// W(|r|) over all offsets r, M = 6σ/H². With f(q) = W/σ the eigenvalues are f''(q)/H²
+    /// along r and f'(q)/(qH²) across it; f'' = 36q − 12 for q ≤ ½ and 12(1 − q) beyond, at
+    /// most 6 (at q = ½), and f'/q < 0. So W(r + δ) ≤ W(r) + ∇W(r)·δ + ½M|δ|² for every r
+    /// and δ (Taylor's theorem with the remainder's integral form; W is twice differentiable).
+    pub fn curvature_bound(&self) -> f64 {
+        6.0 * self.sigma * self.inverse_support * self.inverse_support
+    }
+
     /// ∇W with respect to the first argument of W(x_i − x_j), given `r = x_i − x_j` (metres),
     /// in 1/m⁴.
     #[inline]
@@ -104,6 +113,45 @@ mod tests {
         }
         let integral = sum * dr / 3.0;
         assert!((integral - 1.0).abs() < 1e-6, "integral {integral}");
+    }
+
+    /// W(r + δ) ≤ W(r) + ∇W(r)·δ + ½M|δ|² with M = [`CubicKernel::curvature_bound`], for
+    /// offsets across the whole support and steps in every direction; and the bound is
+    /// nearly attained, so M is not loose.
+    #[test]
+    fn curvature_bound_majorises_the_second_order_remainder() {
+        let h = 0.1;
+        let kernel = CubicKernel::new(h);
+        let m = kernel.curvature_bound();
+        let mut seed = 12345u64;
+        let mut uniform = || {
+            seed = seed
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+        };
+        let mut worst: f64 = 0.0;
+        for _ in 0..200_000 {
+            let r = Vec3::new(uniform(), uniform(), uniform()) * (1.1 * h);
+            let delta = Vec3::new(uniform(), uniform(), uniform()) * (0.2 * h * uniform().abs());
+            let bound = 0.5 * m * delta.norm_squared();
+            if bound == 0.0 {
+                continue;
+            }
+            let remainder =
+                kernel.w((r + delta).norm()) - kernel.w(r.norm()) - kernel.grad_w(&r).dot(&delta);
+            assert!(
+                remainder <= bound * (1.0 + 1e-9) + 1e-12,
+                "r {r:?} delta {delta:?}"
+            );
+            worst = worst.max(remainder / bound);
+        }
+        assert!(worst > 0.9, "largest remainder / bound {worst}");
+        // The radial second derivative at q = ½ is M exactly.
+        let e = 1e-5 * h;
+        let second =
+            (kernel.w(0.5 * h + e) - 2.0 * kernel.w(0.5 * h) + kernel.w(0.5 * h - e)) / (e * e);
+        assert!((second / m - 1.0).abs() < 1e-3, "W''(H/2) {second}, M {m}");
     }
 
     #[test]

@@ -80,6 +80,7 @@ impl World {
                 rest_stencil_size: params.rest_stencil_size(),
                 materialize_all: false,
                 portable: false,
+                evaluate_first_step: false,
             },
             pool,
             fluid: Fluid::default(),

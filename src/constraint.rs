@@ -451,16 +451,17 @@ impl DensityConstraint {
         nb: &Neighborhood,
         projections: &[Projection],
         corrections: &Corrections,
-        gather_slots: &[u32],
     ) -> Vec3 {
         let scale = self.weight_of(nb, j) * self.mass / self.rest_density;
-        let first = nb.fluid.offsets[j] as usize;
         let mut sum = projections[j].self_correction;
-        for (k, &i) in nb.fluid.of(j).iter().enumerate() {
-            let (i, lambda) = (i as usize, corrections.lambdas[i as usize]);
+        for &i in nb.fluid.of(j) {
+            let i = i as usize;
+            let lambda = corrections.lambdas[i];
             if corrections.kept[i] {
-                // j's place in i's list, after i's own correction at the segment's start.
-                let member = gather_slots[first + k] - nb.fluid.offsets[i] + 1;
+                // j's place in i's ascending list (the lists are symmetric), after i's own
+                // correction at the segment's start.
+                let place = nb.fluid.of(i).binary_search(&(j as u32));
+                let member = place.expect("neighbour lists are symmetric") as u32 + 1;
                 sum += corrections.data[(projections[i].segment + member) as usize];
             } else if lambda != 0.0 {
                 // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).

@@ -233,8 +233,6 @@ pub struct NeighborLists {
     scratch: Vec<(Vec<u32>, Vec<u32>)>,
     /// The searched points by component, for [`UniformGrid::search`].
     coordinates: Coordinates,
-    /// Scratch of [`NeighborLists::reverse_slots`]: the next slot of every list.
-    cursors: Vec<u32>,
 }
 
 impl NeighborLists {
@@ -258,32 +256,6 @@ impl NeighborLists {
     /// True when there are no queries.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
-    }
-
-    /// For symmetric lists (i lists j exactly when j lists i): for every pair slot k of query
-    /// i pointing to j, the slot of i inside j's list.
-    ///
-    /// One pass over the pairs in query order with a cursor per list: j's list is ascending,
-    /// so the queries that list j reach it in the order they appear in its list, and the
-    /// cursor of j stands at i's place when query i reaches j (no search).
-    pub fn reverse_slots(&mut self, reverse: &mut Vec<u32>) {
-        reverse.resize(self.indices.len(), 0);
-        let mut cursors = std::mem::take(&mut self.cursors);
-        cursors.clear();
-        cursors.extend_from_slice(&self.offsets[..self.len()]);
-        for i in 0..self.len() {
-            let range = self.offsets[i] as usize..self.offsets[i + 1] as usize;
-            for (slot, &j) in reverse[range.clone()].iter_mut().zip(&self.indices[range]) {
-                let cursor = &mut cursors[j as usize];
-                assert!(
-                    self.indices.get(*cursor as usize) == Some(&(i as u32)),
-                    "neighbour lists are symmetric"
-                );
-                *slot = *cursor;
-                *cursor += 1;
-            }
-        }
-        self.cursors = cursors;
     }
 }
 
@@ -541,26 +513,6 @@ mod tests {
                 .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
                 .collect();
             assert_eq!(lists.of(i), brute.as_slice());
-        }
-    }
-
-    #[test]
-    fn reverse_slots_point_back() {
-        let pts = random_points(2000, 5, 0.8);
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(0.8), 0.1);
-        let mut table = CellTable::default();
-        let sorted = sorted_copy(&grid, &pts, &mut table);
-        let mut lists = NeighborLists::default();
-        grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
-        let mut reverse = Vec::new();
-        lists.reverse_slots(&mut reverse);
-        for i in 0..lists.len() {
-            for (k, &j) in lists.of(i).iter().enumerate() {
-                let back = reverse[lists.offsets[i] as usize + k] as usize;
-                assert_eq!(lists.indices[back] as usize, i);
-                assert!(back >= lists.offsets[j as usize] as usize);
-                assert!(back < lists.offsets[j as usize + 1] as usize);
-            }
         }
     }
 

@@ -30,8 +30,6 @@ pub(crate) struct StepBuffers {
     table: CellTable,
     fluid_lists: NeighborLists,
     boundary_lists: NeighborLists,
-    /// For pair slot k of particle j (neighbour i): the slot of j in i's list (`reverse_slots`).
-    gather_slots: Vec<u32>,
     system: DiagonalSystem,
     scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
@@ -143,7 +141,6 @@ impl World {
                 false,
                 &mut b.boundary_lists,
             );
-            b.fluid_lists.reverse_slots(&mut b.gather_slots);
             timings.neighbors = started.elapsed().as_secs_f64();
 
             // 3. The system matrix of formulation F1, frozen for the step.
@@ -179,17 +176,11 @@ impl World {
                 constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
                 let t_local = t.elapsed().as_secs_f64();
                 let (projections, corrections) = (&b.projections, &b.corrections);
-                let (slots, current) = (&b.gather_slots, &b.current);
+                let current = &b.current;
                 b.rhs.par_iter_mut().enumerate().for_each(|(j, rhs)| {
                     // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction.
-                    let sum = constraint.gathered_correction(
-                        j,
-                        current,
-                        &nb,
-                        projections,
-                        corrections,
-                        slots,
-                    );
+                    let sum =
+                        constraint.gathered_correction(j, current, &nb, projections, corrections);
                     let members = constraint.membership(lists, j);
                     *rhs = b.predicted[j] * mass + (current[j] * members + sum) * dt2k;
                 });

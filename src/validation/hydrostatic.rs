@@ -343,8 +343,6 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             (NeighborLists::default(), NeighborLists::default());
         grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
         grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
-        let mut slots = Vec::new();
-        fluid_lists.reverse_slots(&mut slots);
         let nb = Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,
@@ -361,7 +359,7 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         let c = &world.constraint;
         let force_sum: f64 = (0..x.len())
             .map(|j| {
-                c.gathered_correction(j, &x, &nb, &projections, &corrections, &slots)
+                c.gathered_correction(j, &x, &nb, &projections, &corrections)
                     .y
             })
             .sum();

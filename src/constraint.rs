@@ -95,6 +95,23 @@ impl Corrections {
     pub fn kept(&self) -> usize {
         self.owners.len()
     }
+
+    /// P_{i,j} − x_j (m) from the segment that projection i kept (out of the gather's hot
+    /// loop: few projections keep one).
+    #[inline(never)]
+    fn kept_correction(
+        &self,
+        i: usize,
+        j: usize,
+        nb: &Neighborhood,
+        projections: &[Projection],
+    ) -> Vec3 {
+        // j's place in i's ascending list (the lists are symmetric), after i's own correction
+        // at the segment's start.
+        let place = nb.fluid.of(i).binary_search(&(j as u32));
+        let member = place.expect("neighbour lists are symmetric") as u32 + 1;
+        self.data[(projections[i].segment + member) as usize]
+    }
 }
 
 /// Per-thread buffers of one projection: its corrections when they are not kept; its fluid
@@ -458,11 +475,7 @@ impl DensityConstraint {
             let i = i as usize;
             let lambda = corrections.lambdas[i];
             if corrections.kept[i] {
-                // j's place in i's ascending list (the lists are symmetric), after i's own
-                // correction at the segment's start.
-                let place = nb.fluid.of(i).binary_search(&(j as u32));
-                let member = place.expect("neighbour lists are symmetric") as u32 + 1;
-                sum += corrections.data[(projections[i].segment + member) as usize];
+                sum += corrections.kept_correction(i, j, nb, projections);
             } else if lambda != 0.0 {
                 // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i).
                 sum += self.kernel.grad_w(&(x[j] - x[i])) * (lambda * scale);

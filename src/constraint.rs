@@ -344,8 +344,8 @@ impl DensityConstraint {
     /// With W(r + δ) ≤ W(r) + ∇W(r)·δ + ½M|δ|² ([`CubicKernel::curvature_bound`]) the new
     /// density is at most ρ_i + ρ0·λ·(w_i|∇_{x_i}C_i|² + Σ_j w_j|∇_{x_j}C_i|²) (the linear
     /// change, negative) + ½M·(m·Σ_j 2(|Δ_i|² + |Δ_j|²) + Σ_b ψ_b|Δ_i|²). The weighted
-    /// step overshoots the linear target by about n̄ + 1, so the bound holds for every
-    /// compression below ≈ 10 %: nearly every projection of a flow.
+    /// step overshoots the linear target by about n̄ + 1, so the bound shows the relaxation
+    /// up to ≈ 1.5 % compression (tested): about 99 % of the active projections of a flow.
     #[inline(always)]
     fn first_step_surely_relaxes(
         &self,

@@ -3,7 +3,8 @@
 //! measured above the lowest fluid particle at the start (`projfluid::driver::energy_datum`).
 //!
 //! `cargo run --release --example calibrate -- SCENE SECONDS SOLVER RHO DELAY OMEGA2 TAU_PER_R`
-//! e.g. `… dam_break_30k 1.0 chebyshev 0.9 3 chebyshev 1e-3`.
+//! e.g. `… dam_break_30k 1.0 chebyshev 0.9 3 chebyshev 1e-3`. Environment: `GAMMA` sets
+//! Chebyshev's under-relaxation γ, `WEIGHT=uniform|unit` the projection weighting.
 use projfluid::driver::{self, RunLength};
 use projfluid::scene::Scene;
 use projfluid::{Omega2Rule, SolverKind};
@@ -26,6 +27,16 @@ fn main() {
     }
     p.chebyshev.delay = a[4].parse().expect("delay");
     p.chebyshev.omega2_rule = Omega2Rule::from_name(&a[5]).expect("omega2");
+    if let Ok(v) = std::env::var("GAMMA") {
+        p.chebyshev.gamma = v.parse().expect("GAMMA");
+    }
+    if let Ok(v) = std::env::var("WEIGHT") {
+        p.projection_weight = match v.as_str() {
+            "uniform" => projfluid::ProjectionWeight::Uniform,
+            "unit" => projfluid::ProjectionWeight::Unit,
+            _ => projfluid::ProjectionWeight::NeighborCount,
+        };
+    }
     p.displacement_tolerance = a[6].parse::<f64>().expect("tau") * p.particle_radius;
     let mut world = scene.build_world().expect("world");
     let acc = driver::run_quietly(&mut world, RunLength::Duration(seconds)).expect("run");

@@ -8,6 +8,8 @@
 //! `WEIGHT=uniform|unit` the projection weighting; `FCC=1` fills the tank with a face-centred
 //! cubic packing at rest density (wall gap `FCCGAP`, m) instead of the cubic lattice;
 //! `MINIT`, `MAXIT` set the least and most outer iterations per step (equal: a fixed count);
+//! `RELEASE_IT=K` fixes K outer iterations per step after the settle; `SMOOTH` splits the
+//! RMS velocity into its kernel average over 2d and the rest;
 //! `LAYERS`, `DISP`, `DUMP` print velocity by region, displacement per initial layer and the
 //! last step's δ_k; `NY` sets the column's height in particles (default 16).
 use projfluid::{boundary::Aabb, *};
@@ -128,6 +130,10 @@ fn main() {
         let z: Vec<Vec3> = world.velocities().iter().map(|v| v * f).collect();
         world.set_velocities(&z).unwrap();
     }
+    if let Ok(v) = std::env::var("RELEASE_IT") {
+        let k: usize = v.parse().unwrap();
+        world.set_outer_iterations(k, k).unwrap();
+    }
     let secs = secs + settle;
     println!(
         "settled {settle} s, ycom {:.6}",
@@ -210,6 +216,32 @@ fn main() {
                         println!();
                     }
                 }
+            }
+            if std::env::var("SMOOTH").is_ok() {
+                // Split the velocity into its kernel average over 2d and the rest.
+                let (ps, vs) = (world.positions(), world.velocities());
+                let h = 2.0 * d;
+                let (mut coh, mut jit) = (0.0, 0.0);
+                for i in 0..ps.len() {
+                    let (mut sw, mut sv) = (0.0, Vec3::zeros());
+                    for j in 0..ps.len() {
+                        let q = (ps[i] - ps[j]).norm() / h;
+                        if q < 1.0 {
+                            let w = (1.0 - q) * (1.0 - q);
+                            sw += w;
+                            sv += vs[j] * w;
+                        }
+                    }
+                    let avg = sv / sw;
+                    coh += avg.norm_squared();
+                    jit += (vs[i] - avg).norm_squared();
+                }
+                let n = ps.len() as f64;
+                println!(
+                    "  coherent {:.4} jitter {:.4}",
+                    (coh / n).sqrt(),
+                    (jit / n).sqrt()
+                );
             }
             if std::env::var("DUMP").is_ok() {
                 println!(

@@ -4,10 +4,11 @@
 //!
 //! `cargo run --release --example calibrate -- SCENE SECONDS SOLVER RHO DELAY OMEGA2 TAU_PER_R`
 //! e.g. `… dam_break_30k 1.0 chebyshev 0.9 3 chebyshev 1e-3`. Environment: `GAMMA` sets
-//! Chebyshev's under-relaxation γ, `WEIGHT=uniform|unit` the projection weighting.
+//! Chebyshev's under-relaxation γ, `WEIGHT=neighbor_count|unit|uniform` the projection
+//! weighting.
 use projfluid::driver::{self, RunLength};
 use projfluid::scene::Scene;
-use projfluid::{Omega2Rule, SolverKind};
+use projfluid::{Omega2Rule, ProjectionWeight, SolverKind};
 
 fn main() {
     let a: Vec<String> = std::env::args().skip(1).collect();
@@ -31,11 +32,7 @@ fn main() {
         p.chebyshev.gamma = v.parse().expect("GAMMA");
     }
     if let Ok(v) = std::env::var("WEIGHT") {
-        p.projection_weight = match v.as_str() {
-            "uniform" => projfluid::ProjectionWeight::Uniform,
-            "unit" => projfluid::ProjectionWeight::Unit,
-            _ => projfluid::ProjectionWeight::NeighborCount,
-        };
+        p.projection_weight = ProjectionWeight::from_name(&v).expect("WEIGHT");
     }
     p.displacement_tolerance = a[6].parse::<f64>().expect("tau") * p.particle_radius;
     let mut world = scene.build_world().expect("world");

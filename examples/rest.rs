@@ -5,7 +5,7 @@
 //! (defaults 3e-3 chebyshev 0.85 2 0.1 2.25). Environment: `SETTLE=s` first runs s seconds with
 //! velocities scaled by `DAMP` (default 0) after every step; `XSPH`, `DTMAX`, `K`, `GAMMA`,
 //! `DELAY` override the viscosity, Δt_max, stiffness and Chebyshev's γ and delay;
-//! `WEIGHT=uniform|unit` the projection weighting; `FCC=1` fills the tank with a face-centred
+//! `WEIGHT=neighbor_count|unit|uniform` the projection weighting; `FCC=1` fills the tank with a face-centred
 //! cubic packing at rest density (wall gap `FCCGAP`, m) instead of the cubic lattice;
 //! `MINIT`, `MAXIT` set the least and most outer iterations per step (equal: a fixed count);
 //! `RELEASE_IT=K` fixes K outer iterations per step after the settle; `SMOOTH` splits the
@@ -28,11 +28,7 @@ fn main() {
     params.chebyshev.rho = rho;
     params.chebyshev.auto_rho = false;
     if let Ok(v) = std::env::var("WEIGHT") {
-        params.projection_weight = match v.as_str() {
-            "uniform" => ProjectionWeight::Uniform,
-            "unit" => ProjectionWeight::Unit,
-            _ => ProjectionWeight::NeighborCount,
-        };
+        params.projection_weight = ProjectionWeight::from_name(&v).expect("WEIGHT");
     }
     if let Ok(v) = std::env::var("GAMMA") {
         params.chebyshev.gamma = v.parse().unwrap();

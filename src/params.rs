@@ -113,9 +113,31 @@ pub enum ProjectionWeight {
     /// ones plus inactive "stay" terms). The converged step's constraint forces are then
     /// k·c·Σ_i λ_i ∇_{x_j}C_i, the gradient of one energy, and conserve momentum; with
     /// `NeighborCount` they are scaled per particle by n_j + 1, which is not conservative
-    /// (README, "Projection weighting"). Experimental: it keeps a resting column calm but
-    /// splashing flows gain energy with it.
+    /// (README, "Projection weighting"). Experimental: it keeps a resting column calmer, but
+    /// splashing flows gain energy with it unless Chebyshev's γ is 0.8 or less.
     Uniform,
+}
+
+impl ProjectionWeight {
+    /// The weighting's name in scenes (`solver.projection_weight`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ProjectionWeight::NeighborCount => "neighbor_count",
+            ProjectionWeight::Unit => "unit",
+            ProjectionWeight::Uniform => "uniform",
+        }
+    }
+
+    /// Parses a weighting's name (see [`ProjectionWeight::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [
+            ProjectionWeight::NeighborCount,
+            ProjectionWeight::Unit,
+            ProjectionWeight::Uniform,
+        ]
+        .into_iter()
+        .find(|w| w.name() == name)
+    }
 }
 
 /// Settings of Chebyshev's semi-iterative acceleration (ALGORITHM.md §3.7).

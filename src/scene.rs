@@ -301,6 +301,25 @@ mod tests {
         assert_eq!(scene.particle_count(), 64 + 12);
     }
 
+    /// A weighting's name is the value scenes write for it, and it parses back; an unknown
+    /// name does not.
+    #[test]
+    fn projection_weight_names_are_the_scene_values() {
+        use crate::ProjectionWeight as W;
+        for w in [W::NeighborCount, W::Unit, W::Uniform] {
+            let text = format!(
+                r#"{{"particle_radius": 0.025, "container": {{"min": [0, 0, 0], "max": [1, 1, 1]}},
+                    "fluid_blocks": [{{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2]}}],
+                    "duration": 1, "solver": {{"projection_weight": "{}"}}}}"#,
+                w.name()
+            );
+            let scene = Scene::from_json(&text).unwrap();
+            assert_eq!(scene.params.projection_weight, w);
+            assert_eq!(W::from_name(w.name()), Some(w));
+        }
+        assert_eq!(W::from_name("neighbour_count"), None);
+    }
+
     #[test]
     fn every_key_is_read() {
         let text = r#"{

@@ -119,6 +119,16 @@ pub enum ProjectionWeight {
 }
 
 impl ProjectionWeight {
+    /// Every weighting.
+    pub const ALL: [ProjectionWeight; 3] = [
+        ProjectionWeight::NeighborCount,
+        ProjectionWeight::Unit,
+        ProjectionWeight::Uniform,
+    ];
+
+    /// Every weighting's name, in the order of [`ProjectionWeight::ALL`].
+    pub const NAMES: [&'static str; 3] = ["neighbor_count", "unit", "uniform"];
+
     /// The weighting's name in scenes (`solver.projection_weight`).
     pub fn name(self) -> &'static str {
         match self {
@@ -130,13 +140,22 @@ impl ProjectionWeight {
 
     /// Parses a weighting's name (see [`ProjectionWeight::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
-        [
-            ProjectionWeight::NeighborCount,
-            ProjectionWeight::Unit,
-            ProjectionWeight::Uniform,
-        ]
-        .into_iter()
-        .find(|w| w.name() == name)
+        Self::ALL.into_iter().find(|w| w.name() == name)
+    }
+}
+
+/// Scene files write a weighting as its name.
+impl serde::Serialize for ProjectionWeight {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.serialize_str(self.name())
+    }
+}
+
+/// Scene files name a weighting; an unknown name is an error listing the known ones.
+impl<'de> serde::Deserialize<'de> for ProjectionWeight {
+    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(deserializer)?;
+        Self::from_name(&name).ok_or_else(|| serde::de::Error::unknown_variant(&name, &Self::NAMES))
     }
 }
 

@@ -47,7 +47,7 @@ struct SolverFile {
     tau: Option<f64>,
     max_iterations: Option<usize>,
     min_iterations: Option<usize>,
-    projection_weight: Option<WeightName>,
+    projection_weight: Option<ProjectionWeight>,
 }
 
 /// `time`: step size control.
@@ -204,15 +204,6 @@ enum Omega2Name {
     Seed,
 }
 
-/// `solver.projection_weight` values.
-#[derive(Serialize, Deserialize, Clone, Copy)]
-#[serde(rename_all = "snake_case")]
-enum WeightName {
-    NeighborCount,
-    Unit,
-    Uniform,
-}
-
 impl From<Omega2Name> for Omega2Rule {
     fn from(n: Omega2Name) -> Self {
         match n {
@@ -227,26 +218,6 @@ impl From<Omega2Rule> for Omega2Name {
         match r {
             Omega2Rule::Chebyshev => Omega2Name::Chebyshev,
             Omega2Rule::SeedLiteral => Omega2Name::Seed,
-        }
-    }
-}
-
-impl From<WeightName> for ProjectionWeight {
-    fn from(n: WeightName) -> Self {
-        match n {
-            WeightName::NeighborCount => ProjectionWeight::NeighborCount,
-            WeightName::Unit => ProjectionWeight::Unit,
-            WeightName::Uniform => ProjectionWeight::Uniform,
-        }
-    }
-}
-
-impl From<ProjectionWeight> for WeightName {
-    fn from(w: ProjectionWeight) -> Self {
-        match w {
-            ProjectionWeight::NeighborCount => WeightName::NeighborCount,
-            ProjectionWeight::Unit => WeightName::Unit,
-            ProjectionWeight::Uniform => WeightName::Uniform,
         }
     }
 }
@@ -363,9 +334,7 @@ impl SceneFile {
         set(&mut p.displacement_tolerance, s.tau);
         p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
         p.min_outer_iterations = s.min_iterations.unwrap_or(p.min_outer_iterations);
-        p.projection_weight = s
-            .projection_weight
-            .map_or(p.projection_weight, ProjectionWeight::from);
+        p.projection_weight = s.projection_weight.unwrap_or(p.projection_weight);
         let t = self.time.unwrap_or_default();
         set(&mut p.cfl_factor, t.cfl_factor);
         set(&mut p.dt_min, t.dt_min);
@@ -429,7 +398,7 @@ impl SceneFile {
                 tau: Some(p.displacement_tolerance),
                 max_iterations: Some(p.max_outer_iterations),
                 min_iterations: Some(p.min_outer_iterations),
-                projection_weight: Some(p.projection_weight.into()),
+                projection_weight: Some(p.projection_weight),
             }),
             time: Some(TimeFile {
                 cfl_factor: Some(p.cfl_factor),

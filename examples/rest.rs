@@ -99,6 +99,31 @@ fn main() {
             .unwrap();
         let v = vec![Vec3::zeros(); pts.len()];
         world.add_fluid_particles(&pts, Some(&v)).unwrap();
+    } else if let Ok(path) = std::env::var("LOAD") {
+        world
+            .add_container(
+                Aabb {
+                    min: Vec3::repeat(floor),
+                    max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
+                },
+                1,
+            )
+            .unwrap();
+        let raw = std::fs::read(path).unwrap();
+        let f: Vec<f64> = raw
+            .chunks(8)
+            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+            .collect();
+        let half = f.len() / 2;
+        let pts: Vec<Vec3> = f[..half]
+            .chunks(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        let vel: Vec<Vec3> = f[half..]
+            .chunks(3)
+            .map(|c| Vec3::new(c[0], c[1], c[2]))
+            .collect();
+        world.add_fluid_particles(&pts, Some(&vel)).unwrap();
     } else {
         world
             .add_container(
@@ -113,18 +138,51 @@ fn main() {
             .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
             .unwrap();
     }
+    if let Ok(path) = std::env::var("BDUMP") {
+        let mut raw = Vec::new();
+        for v in world.boundary_positions() {
+            for c in v.iter() {
+                raw.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        std::fs::write(path, raw).unwrap();
+    }
     let step_out: f64 = arg(5, "0.1").parse().unwrap();
     let initial = world.positions();
     let settle: f64 = std::env::var("SETTLE")
         .map(|v| v.parse().unwrap())
         .unwrap_or(0.0);
+    let kinetic_damping = std::env::var("KDAMP").is_ok();
+    let mut last_ek = 0.0;
     while world.time() < settle - 1e-9 {
         world.step().unwrap();
+        if kinetic_damping {
+            // Dynamic relaxation: stop every particle when the kinetic energy has peaked.
+            let ek = world.kinetic_energy();
+            if ek < last_ek {
+                world
+                    .set_velocities(&vec![Vec3::zeros(); world.fluid_count()])
+                    .unwrap();
+                last_ek = 0.0;
+            } else {
+                last_ek = ek;
+            }
+            continue;
+        }
         let f: f64 = std::env::var("DAMP")
             .map(|v| v.parse().unwrap())
             .unwrap_or(0.0);
         let z: Vec<Vec3> = world.velocities().iter().map(|v| v * f).collect();
         world.set_velocities(&z).unwrap();
+    }
+    if let Ok(path) = std::env::var("SAVE") {
+        let mut raw = Vec::new();
+        for v in world.positions().iter().chain(world.velocities().iter()) {
+            for c in v.iter() {
+                raw.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        std::fs::write(path, raw).unwrap();
     }
     if let Ok(v) = std::env::var("RELEASE_IT") {
         let k: usize = v.parse().unwrap();

@@ -12,6 +12,10 @@
 //! RMS velocity into its kernel average over 2d and the rest;
 //! `LAYERS`, `DISP`, `DUMP` print velocity by region, displacement per initial layer and the
 //! last step's δ_k; `NY` sets the column's height in particles (default 16).
+//! `SAVE=FILE` writes the settled state (positions, then velocities, f64) and `LOAD=FILE`
+//! starts from such a file instead of the lattice; `KDAMP=1` settles by stopping every
+//! particle whenever the kinetic energy has peaked instead of scaling; `BDUMP=FILE` writes the
+//! boundary positions (for `tools/rest_reference.py`).
 use projfluid::{boundary::Aabb, *};
 fn main() {
     let a: Vec<String> = std::env::args().collect();
@@ -99,7 +103,7 @@ fn main() {
             .unwrap();
         let v = vec![Vec3::zeros(); pts.len()];
         world.add_fluid_particles(&pts, Some(&v)).unwrap();
-    } else if let Ok(path) = std::env::var("LOAD") {
+    } else {
         world
             .add_container(
                 Aabb {
@@ -109,6 +113,9 @@ fn main() {
                 1,
             )
             .unwrap();
+    }
+    if std::env::var("FCC").is_ok() {
+    } else if let Ok(path) = std::env::var("LOAD") {
         let raw = std::fs::read(path).unwrap();
         let f: Vec<f64> = raw
             .chunks(8)
@@ -125,15 +132,6 @@ fn main() {
             .collect();
         world.add_fluid_particles(&pts, Some(&vel)).unwrap();
     } else {
-        world
-            .add_container(
-                Aabb {
-                    min: Vec3::repeat(floor),
-                    max: Vec3::new(floor + inner(n[0]), 1.5, floor + inner(n[2])),
-                },
-                1,
-            )
-            .unwrap();
         world
             .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
             .unwrap();

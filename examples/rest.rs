@@ -113,37 +113,18 @@ fn main() {
                 1,
             )
             .unwrap();
-    }
-    if std::env::var("FCC").is_ok() {
-    } else if let Ok(path) = std::env::var("LOAD") {
-        let raw = std::fs::read(path).unwrap();
-        let f: Vec<f64> = raw
-            .chunks(8)
-            .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
-            .collect();
-        let half = f.len() / 2;
-        let pts: Vec<Vec3> = f[..half]
-            .chunks(3)
-            .map(|c| Vec3::new(c[0], c[1], c[2]))
-            .collect();
-        let vel: Vec<Vec3> = f[half..]
-            .chunks(3)
-            .map(|c| Vec3::new(c[0], c[1], c[2]))
-            .collect();
-        world.add_fluid_particles(&pts, Some(&vel)).unwrap();
-    } else {
-        world
-            .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
-            .unwrap();
+        if let Ok(path) = std::env::var("LOAD") {
+            let state = read_vec3s(&path);
+            let (pts, vel) = state.split_at(state.len() / 2);
+            world.add_fluid_particles(pts, Some(vel)).unwrap();
+        } else {
+            world
+                .add_fluid_block(Vec3::repeat(d), n, Vec3::zeros())
+                .unwrap();
+        }
     }
     if let Ok(path) = std::env::var("BDUMP") {
-        let mut raw = Vec::new();
-        for v in world.boundary_positions() {
-            for c in v.iter() {
-                raw.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        std::fs::write(path, raw).unwrap();
+        write_vec3s(&path, world.boundary_positions());
     }
     let step_out: f64 = arg(5, "0.1").parse().unwrap();
     let initial = world.positions();
@@ -174,13 +155,7 @@ fn main() {
         world.set_velocities(&z).unwrap();
     }
     if let Ok(path) = std::env::var("SAVE") {
-        let mut raw = Vec::new();
-        for v in world.positions().iter().chain(world.velocities().iter()) {
-            for c in v.iter() {
-                raw.extend_from_slice(&c.to_le_bytes());
-            }
-        }
-        std::fs::write(path, raw).unwrap();
+        write_vec3s(&path, &[world.positions(), world.velocities()].concat());
     }
     if let Ok(v) = std::env::var("RELEASE_IT") {
         let k: usize = v.parse().unwrap();
@@ -310,6 +285,21 @@ fn main() {
         }
     }
 }
-// (diagnostic) δ_k sequence of the last step, printed when DUMP is set.
-#[allow(dead_code)]
-fn unused() {}
+/// Writes `points` to `path` as little-endian f64 triples.
+fn write_vec3s(path: &str, points: &[Vec3]) {
+    let raw: Vec<u8> = points
+        .iter()
+        .flat_map(|p| p.iter().flat_map(|c| c.to_le_bytes()).collect::<Vec<u8>>())
+        .collect();
+    std::fs::write(path, raw).unwrap();
+}
+
+/// Reads the points [`write_vec3s`] wrote.
+fn read_vec3s(path: &str) -> Vec<Vec3> {
+    let raw = std::fs::read(path).unwrap();
+    let f: Vec<f64> = raw
+        .chunks(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap()))
+        .collect();
+    f.chunks(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect()
+}

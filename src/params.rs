@@ -60,20 +60,27 @@ impl SolverKind {
     }
 }
 
-/// Scene files write a solver as its name.
-impl serde::Serialize for SolverKind {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.serialize_str(self.name())
-    }
+/// Scene files write a parameter enum as its `name()` and read it back with `from_name`; an
+/// unknown name is an error listing the known ones (`NAMES`).
+macro_rules! serde_by_name {
+    ($t:ty) => {
+        impl serde::Serialize for $t {
+            fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+                serializer.serialize_str(self.name())
+            }
+        }
+
+        impl<'de> serde::Deserialize<'de> for $t {
+            fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
+                let name = String::deserialize(deserializer)?;
+                Self::from_name(&name)
+                    .ok_or_else(|| serde::de::Error::unknown_variant(&name, &Self::NAMES))
+            }
+        }
+    };
 }
 
-/// Scene files name a solver; an unknown name is an error listing the known ones.
-impl<'de> serde::Deserialize<'de> for SolverKind {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let name = String::deserialize(deserializer)?;
-        Self::from_name(&name).ok_or_else(|| serde::de::Error::unknown_variant(&name, &Self::NAMES))
-    }
-}
+serde_by_name!(SolverKind);
 
 /// How ω₂, the first Chebyshev weight, is chosen (ALGORITHM.md §3.7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +92,12 @@ pub enum Omega2Rule {
 }
 
 impl Omega2Rule {
+    /// Every rule.
+    pub const ALL: [Omega2Rule; 2] = [Omega2Rule::Chebyshev, Omega2Rule::SeedLiteral];
+
+    /// Every rule's name, in the order of [`Omega2Rule::ALL`].
+    pub const NAMES: [&'static str; 2] = ["chebyshev", "seed"];
+
     /// The rule's name in scenes and on the command line.
     pub fn name(self) -> &'static str {
         match self {
@@ -95,11 +108,11 @@ impl Omega2Rule {
 
     /// Parses a rule name (see [`Omega2Rule::name`]).
     pub fn from_name(name: &str) -> Option<Self> {
-        [Omega2Rule::Chebyshev, Omega2Rule::SeedLiteral]
-            .into_iter()
-            .find(|r| r.name() == name)
+        Self::ALL.into_iter().find(|r| r.name() == name)
     }
 }
+
+serde_by_name!(Omega2Rule);
 
 /// Weight w_j applied to a particle's share of a local projection (ALGORITHM.md §2.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -144,20 +157,7 @@ impl ProjectionWeight {
     }
 }
 
-/// Scene files write a weighting as its name.
-impl serde::Serialize for ProjectionWeight {
-    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
-        serializer.serialize_str(self.name())
-    }
-}
-
-/// Scene files name a weighting; an unknown name is an error listing the known ones.
-impl<'de> serde::Deserialize<'de> for ProjectionWeight {
-    fn deserialize<D: serde::Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        let name = String::deserialize(deserializer)?;
-        Self::from_name(&name).ok_or_else(|| serde::de::Error::unknown_variant(&name, &Self::NAMES))
-    }
-}
+serde_by_name!(ProjectionWeight);
 
 /// Settings of Chebyshev's semi-iterative acceleration (ALGORITHM.md §3.7).
 #[derive(Clone, Copy, Debug, PartialEq)]

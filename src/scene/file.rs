@@ -42,7 +42,7 @@ struct SolverFile {
     kind: Option<SolverKind>,
     rho: Option<RhoSetting>,
     delay: Option<usize>,
-    omega2: Option<Omega2Name>,
+    omega2: Option<Omega2Rule>,
     gamma: Option<f64>,
     tau: Option<f64>,
     max_iterations: Option<usize>,
@@ -196,32 +196,6 @@ impl<'de> Deserialize<'de> for RhoSetting {
     }
 }
 
-/// `solver.omega2` values.
-#[derive(Serialize, Deserialize, Clone, Copy)]
-#[serde(rename_all = "lowercase")]
-enum Omega2Name {
-    Chebyshev,
-    Seed,
-}
-
-impl From<Omega2Name> for Omega2Rule {
-    fn from(n: Omega2Name) -> Self {
-        match n {
-            Omega2Name::Chebyshev => Omega2Rule::Chebyshev,
-            Omega2Name::Seed => Omega2Rule::SeedLiteral,
-        }
-    }
-}
-
-impl From<Omega2Rule> for Omega2Name {
-    fn from(r: Omega2Rule) -> Self {
-        match r {
-            Omega2Rule::Chebyshev => Omega2Name::Chebyshev,
-            Omega2Rule::SeedLiteral => Omega2Name::Seed,
-        }
-    }
-}
-
 /// `container`: one object or an array of objects; written back as an array.
 struct Containers(Vec<ContainerSpec>);
 
@@ -329,7 +303,7 @@ impl SceneFile {
             None => {}
         }
         c.delay = s.delay.unwrap_or(c.delay);
-        c.omega2_rule = s.omega2.map_or(c.omega2_rule, Omega2Rule::from);
+        c.omega2_rule = s.omega2.unwrap_or(c.omega2_rule);
         set(&mut c.gamma, s.gamma);
         set(&mut p.displacement_tolerance, s.tau);
         p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
@@ -393,7 +367,7 @@ impl SceneFile {
                     RhoSetting::Value(c.rho)
                 }),
                 delay: Some(c.delay),
-                omega2: Some(c.omega2_rule.into()),
+                omega2: Some(c.omega2_rule),
                 gamma: Some(c.gamma),
                 tau: Some(p.displacement_tolerance),
                 max_iterations: Some(p.max_outer_iterations),

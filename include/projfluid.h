@@ -398,6 +398,18 @@ enum PfStatus pf_world_add_obj(struct PfWorld *world,
 enum PfStatus pf_params_default(struct PfParams *out);
 
 /**
+ * Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
+ * at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4 times its particle radius), under which a
+ * settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
+ * field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
+ * does not validate, leaving it unchanged.
+ *
+ * # Safety
+ * `params` must be NULL or point to a readable and writable `PfParams`.
+ */
+enum PfStatus pf_params_calm(struct PfParams *params);
+
+/**
  * Checks `*params` without creating a world: `PF_OK` when `pf_world_create` would accept it,
  * otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field.
  *
@@ -557,6 +569,21 @@ enum PfStatus pf_world_step(struct PfWorld *world, double dt);
  * `world` must be NULL or a live handle from `pf_world_create`.
  */
 enum PfStatus pf_world_advance(struct PfWorld *world, double seconds);
+
+/**
+ * Relaxes the fluid towards its equilibrium: takes CFL-limited steps like
+ * `pf_world_advance` for `seconds`, and after every step of Δt scales every fluid velocity
+ * by exp(−`damping`·Δt) (`damping` in 1/s; 0 is `pf_world_advance`). A block of particles
+ * on a lattice is not at rest under gravity; 10 s at 4/s bring a tank to its equilibrium
+ * packing, from which it stays at rest under the calm settings (`pf_params_calm`).
+ *
+ * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds or damping negative or not finite; no fluid
+ * particles while seconds > 0), taking no step.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`.
+ */
+enum PfStatus pf_world_relax(struct PfWorld *world, double seconds, double damping);
 
 /**
  * Stores the number of fluid particles in `*out`.

@@ -132,6 +132,16 @@ impl World {
         Ok(())
     }
 
+    /// Changes the outer stopping threshold τ (m) between steps. Rejects values that
+    /// [`Params::validate`] rejects, changing nothing.
+    pub fn set_displacement_tolerance(&mut self, tolerance: f64) -> Result<(), Error> {
+        let mut params = self.params.clone();
+        params.displacement_tolerance = tolerance;
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
     /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
     /// Rejects non-finite values and length mismatches without changing the world.
     pub fn add_fluid_particles(

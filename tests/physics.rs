@@ -84,41 +84,16 @@ fn assert_column_holds(world: &World, container: &Aabb, worst: f64) {
     );
 }
 
-/// The settings under which a tank at rest stays at rest (README, "A tank at rest: the calm
-/// settings"): the uniform projection weighting, whose converged constraint forces derive
-/// from one energy, solved to τ = 3·10⁻⁴·r with Chebyshev at ρ = 0.99 and γ = 0.5 (γ keeps the iteration
-/// stable in fully compressed fluid, where the projections' sum overshoots by up to ≈ 3.8).
-fn calm_params() -> Params {
-    let mut params = Params::default();
-    params.projection_weight = ProjectionWeight::Uniform;
-    params.displacement_tolerance = 3e-4 * params.particle_radius;
-    params.chebyshev.rho = 0.99;
-    params.chebyshev.auto_rho = false;
-    params.chebyshev.gamma = 0.5;
-    params
-}
-
-/// Relaxes `world` towards its equilibrium: `seconds` of steps, every velocity scaled by
-/// `factor` after each.
-fn settle(world: &mut World, seconds: f64, factor: f64) {
-    let until = world.time() + seconds;
-    while world.time() < until - 1e-12 {
-        world.step().expect("step");
-        let damped: Vec<Vec3> = world.velocities().iter().map(|v| v * factor).collect();
-        world.set_velocities(&damped).expect("velocities");
-    }
-}
-
 /// A column at rest density stays at rest: released from its equilibrium, it moves at less
 /// than 1 cm/s RMS after 2 s, loses no particle, is not compressed and keeps its height.
-/// The equilibrium is found by 10 s of steps with every velocity scaled by 0.98 after each
-/// (the cubic lattice is not one: its layers slide into each other's hollows), with the
-/// same settings, so that the 2 s after release test the solver on a packing that has
-/// nothing left to release.
+/// The equilibrium is found by 10 s of relaxation at a damping rate of 4/s (the cubic
+/// lattice is not one: its layers slide into each other's hollows), with the calm settings
+/// ([`Params::calm`]) throughout, so that the 2 s after release test the solver on a packing
+/// that has nothing left to release.
 #[test]
 fn resting_water_column_comes_to_rest() {
-    let (mut world, container) = column_world(calm_params());
-    settle(&mut world, 10.0, 0.98);
+    let (mut world, container) = column_world(Params::default().calm());
+    world.relax(10.0, 4.0).expect("relaxation");
     let released = world.time();
     let mut worst: f64 = 0.0;
     run(&mut world, released + 2.0, |w| {

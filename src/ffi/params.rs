@@ -256,6 +256,26 @@ pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
     })
 }
 
+/// Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
+/// at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4 times its particle radius), under which a
+/// settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
+/// field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
+/// does not validate, leaving it unchanged.
+///
+/// # Safety
+/// `params` must be NULL or point to a readable and writable `PfParams`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_params_calm(params: *mut PfParams) -> PfStatus {
+    status_call("pf_params_calm", || {
+        let raw = super::checked_mut_ptr(params, "params")?;
+        // SAFETY: checked non-NULL and aligned; the caller guarantees it is readable.
+        let calm = unsafe { read_params(raw) }?.calm();
+        // SAFETY: as above; the caller guarantees it is writable.
+        unsafe { raw.write(PfParams::from(&calm)) };
+        Ok(())
+    })
+}
+
 /// Checks `*params` without creating a world: `PF_OK` when `pf_world_create` would accept it,
 /// otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field.
 ///

@@ -468,6 +468,31 @@ pub unsafe extern "C" fn pf_world_advance(world: *mut PfWorld, seconds: f64) -> 
     })
 }
 
+/// Relaxes the fluid towards its equilibrium: takes CFL-limited steps like
+/// `pf_world_advance` for `seconds`, and after every step of Δt scales every fluid velocity
+/// by exp(−`damping`·Δt) (`damping` in 1/s; 0 is `pf_world_advance`). A block of particles
+/// on a lattice is not at rest under gravity; 10 s at 4/s bring a tank to its equilibrium
+/// packing, from which it stays at rest under the calm settings (`pf_params_calm`).
+///
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds or damping negative or not finite; no fluid
+/// particles while seconds > 0), taking no step.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_relax(
+    world: *mut PfWorld,
+    seconds: f64,
+    damping: f64,
+) -> PfStatus {
+    status_call("pf_world_relax", || {
+        // SAFETY: forwarded from the caller's promises.
+        let mut world = unsafe { lock(world) }?;
+        world.relax(seconds, damping)?;
+        Ok(())
+    })
+}
+
 /// Stores the number of fluid particles in `*out`.
 ///
 /// # Safety

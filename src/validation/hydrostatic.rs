@@ -11,45 +11,71 @@
 //! local step's multiplier at the final positions. It is a reading of the constraint forces
 //! (their magnitude is set by the force balance, not by an equation of state), so it measures
 //! whether the constraints carry the weight of the water the way a pressure field would.
+//!
+//! Reading forces from positions needs a tighter solve than moving the water does. An iterate
+//! δ from the fixed point changes the global step's force on a particle by about
+//! (m + Δt²·k·w)·δ/Δt², at Δt = 5 ms and w = c = 33.5 about 1.4 times its weight per
+//! micrometre, so the τ = 3·10⁻⁴·r (7.5 µm) that keeps the tank at rest leaves the mean
+//! vertical constraint force at 1.3–1.9 times the weight. The
+//! pressure is therefore read over [`READING_WINDOW`] more seconds solved to
+//! [`READING_TOLERANCE_PER_RADIUS`]·r, after the motion and density have been measured.
 
 use crate::boundary::Aabb;
 use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
 use crate::plot::{LineChart, Series, SeriesStyle};
-use crate::{Error, Params, ProjectionWeight, SolverKind, Vec3, World};
+use crate::{Error, Params, SolverKind, Vec3, World};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 
-/// How the tank is set up and how long it settles.
+/// Length of the pressure reading after the free run (s).
+pub const READING_WINDOW: f64 = 0.25;
+/// τ of the pressure reading as a multiple of the particle radius: the force balance is
+/// within 3 % of the weight at 1e-5, 15 % off at 3e-5 (README, "Validation").
+pub const READING_TOLERANCE_PER_RADIUS: f64 = 1e-5;
+
+/// How the tank is set up, how it is brought to its equilibrium and how long it then runs
+/// freely.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Setup {
     /// Fluid lattice (x, y, z) in particles; y is up.
     pub count: [usize; 3],
     /// Particle radius r (m).
     pub particle_radius: f64,
-    /// Settling time (s).
+    /// Relaxation time (s): the lattice is stepped this long with damped velocities
+    /// ([`World::relax`]) to find its equilibrium packing; 0 releases the lattice as built.
+    pub relax: f64,
+    /// Velocity damping rate of the relaxation (1/s).
+    pub damping: f64,
+    /// Free settling time after the relaxation (s): the measured part of the run.
     pub settle: f64,
     /// Global solver.
     pub solver: SolverKind,
-    /// Outer stopping threshold τ (m); `None` for the default 3e-3·r.
+    /// Use the calm settings ([`Params::calm`]) rather than the defaults.
+    pub calm: bool,
+    /// Outer stopping threshold τ (m); `None` for that of the settings chosen by `calm`.
     pub tolerance: Option<f64>,
+    /// τ of the pressure reading (m); `None` for [`READING_TOLERANCE_PER_RADIUS`]·r.
+    pub reading_tolerance: Option<f64>,
     /// Worker threads (0 = one per core).
     pub threads: usize,
-    /// Weighting of the local projection.
-    pub weight: ProjectionWeight,
 }
 
 impl Default for Setup {
-    /// 12 × 16 × 12 particles of radius 0.025 m, settling for 2 s with the default solver.
+    /// 12 × 16 × 12 particles of radius 0.025 m with the calm settings, relaxed for 10 s at
+    /// 4/s (every velocity scaled by ≈ 0.98 per 5 ms step), then settling freely for 2 s.
     fn default() -> Self {
         Self {
             count: [12, 16, 12],
             particle_radius: crate::params::DEFAULT_PARTICLE_RADIUS,
+            relax: 10.0,
+            damping: 4.0,
             settle: 2.0,
             solver: SolverKind::Chebyshev,
+            calm: true,
             tolerance: None,
+            reading_tolerance: None,
             threads: 0,
-            weight: ProjectionWeight::NeighborCount,
         }
     }
 }
@@ -72,6 +98,32 @@ impl Setup {
                 "must lie in (0, 60] seconds",
             ));
         }
+        if !(self.relax.is_finite() && (0.0..=60.0).contains(&self.relax)) {
+            return Err(Error::invalid(
+                "relax",
+                self.relax,
+                "must lie in [0, 60] seconds",
+            ));
+        }
+        if !(self.damping.is_finite() && self.damping >= 0.0) {
+            return Err(Error::invalid(
+                "damping",
+                self.damping,
+                "must be a non-negative finite rate (1/s)",
+            ));
+        }
+        for (name, tau) in [
+            ("tau", self.tolerance),
+            ("reading-tau", self.reading_tolerance),
+        ] {
+            if let Some(tau) = tau.filter(|t| !(t.is_finite() && *t > 0.0)) {
+                return Err(Error::invalid(
+                    name,
+                    tau,
+                    "must be a positive finite number of metres",
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -79,12 +131,14 @@ impl Setup {
     /// spacing plus r/4 from the walls, and a lid well above it.
     pub fn build(&self) -> Result<(World, Aabb), Error> {
         self.validate()?;
-        let defaults = Params::with_radius(self.particle_radius);
+        let mut defaults = Params::with_radius(self.particle_radius);
+        if self.calm {
+            defaults = defaults.calm();
+        }
         let params = Params {
             mass_factor: 1.0,
             solver: self.solver,
             threads: self.threads,
-            projection_weight: self.weight,
             displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),
             ..defaults
         };
@@ -129,13 +183,13 @@ pub struct Report {
     pub particles: usize,
     /// Lattice spacing d (m).
     pub spacing: f64,
-    /// Average compression of the last step (dimensionless).
+    /// Average compression of the free run's last step (dimensionless).
     pub density_error_avg: f64,
-    /// Largest compression of the last step (dimensionless).
+    /// Largest compression of the free run's last step (dimensionless).
     pub density_error_max: f64,
-    /// Largest per-step average compression over the whole run (dimensionless).
+    /// Largest per-step average compression over the free settling (dimensionless).
     pub density_error_avg_worst: f64,
-    /// RMS speed at the end (m/s).
+    /// RMS speed at the end of the free run (m/s).
     pub rms_velocity: f64,
     /// Water height H above the floor plane: the mean top-layer centre plus d/2, less the
     /// d/2 between the floor plane and the water's bottom face (m).
@@ -144,11 +198,13 @@ pub struct Report {
     pub expected_height: f64,
     /// Fluid particles outside the tank or non-finite.
     pub escaped: usize,
+    /// Outer stopping threshold τ of the pressure reading (m).
+    pub reading_tolerance: f64,
     /// (height above the floor plane (m), pressure estimate (Pa)) of every particle after the
     /// last step.
     pub pressures: Vec<(f64, f64)>,
     /// Layer means over particles at least one support radius from the side walls, averaged
-    /// over the steps of the last quarter second.
+    /// over the steps of the reading window.
     pub profile: Vec<Layer>,
     /// Least-squares slope −dp/dy of the layer means at least one support radius from the
     /// surface and the floor, where particle pressures under-read (Pa/m); ρ0·g for a
@@ -160,8 +216,9 @@ pub struct Report {
     /// shape of the profile, whatever its scale (1 for a linear profile).
     pub shape_correlation: f64,
     /// Mean vertical constraint force per particle, Σ_i k·(P_ij − x_j), evaluated at the end of
-    /// each step of the last quarter second, over the particle weight m·g: 1 when the constraints are at the fixed point
-    /// that holds the water up, larger when the outer iteration stopped short of it.
+    /// each step of the reading window, over the particle weight m·g: 1 when the constraints
+    /// are at the fixed point that holds the water up, larger when the outer iteration stopped
+    /// short of it.
     pub force_balance: f64,
 }
 
@@ -187,53 +244,65 @@ pub fn water_height(world: &World, tank: &Aabb) -> (f64, f64) {
     (height, volume / ((size.x - d) * (size.z - d)))
 }
 
-/// Lets the tank settle for `setup.settle` seconds and measures it; `progress` receives the
-/// fraction done after each step.
+/// Relaxes the tank for `setup.relax` seconds, lets it settle freely for `setup.settle`
+/// seconds and measures it, then reads the pressure over [`READING_WINDOW`] more seconds
+/// solved to `setup.reading_tolerance`; `progress` receives the fraction done as the run goes.
 pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
     let (mut world, tank) = setup.build()?;
+    let settled = setup.relax + setup.settle;
+    let end = settled + READING_WINDOW;
+    // The relaxation in slices of at most a quarter second, for the progress report.
+    while setup.relax - world.time() > 1e-12 * setup.relax {
+        world.relax((setup.relax - world.time()).min(0.25), setup.damping)?;
+        progress(world.time() / end);
+    }
     let mut worst: f64 = 0.0;
-    let end = setup.settle;
+    run_until(&mut world, settled, |w| {
+        worst = worst.max(w.last_step().map_or(0.0, |s| s.density_error_avg));
+        progress(w.time() / end);
+    })?;
+    let (density_error_avg, density_error_max) = world
+        .last_step()
+        .map_or((0.0, 0.0), |s| (s.density_error_avg, s.density_error_max));
+    let rms_velocity = world.rms_velocity();
+    let (height, expected_height) = water_height(&world, &tank);
+    let escaped = world.escaped_count() + world.nan_count();
+
     let d = world.params().spacing();
     let h_support = world.params().support_radius();
+    let reading_tolerance = setup
+        .reading_tolerance
+        .unwrap_or(READING_TOLERANCE_PER_RADIUS * setup.particle_radius);
+    world.set_displacement_tolerance(reading_tolerance)?;
     let inner = |p: &Vec3| {
         p.x - tank.min.x >= h_support
             && tank.max.x - p.x >= h_support
             && p.z - tank.min.z >= h_support
             && tank.max.z - p.z >= h_support
     };
-    // Layer sums (pressure, height, particles) over the last quarter second, or the last
-    // quarter of the run if shorter: one step's multipliers are noisy.
-    let window_start = end - (0.25_f64).min(0.25 * end);
+    // Layer sums (pressure, height, particles) over the reading window: one step's
+    // multipliers are noisy.
     let layers = ((tank.max.y - tank.min.y) / d).ceil() as usize + 1;
     let mut sums = vec![(0.0, 0.0, 0usize); layers];
     let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
     let mut estimates = Vec::new();
-    while end - world.time() > 1e-12 * end {
-        let dt = world.next_dt().min(end - world.time());
-        let step = world.step_with_dt(dt)?;
-        worst = worst.max(step.density_error_avg);
-        if world.time() >= window_start {
-            let support;
-            (estimates, support) = constraint_pressures(&world);
-            for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
-                let y = p.y - tank.min.y;
-                let i = ((y / d).max(0.0) as usize).min(layers - 1);
-                sums[i].0 += v;
-                sums[i].1 += y;
-                sums[i].2 += 1;
-            }
-            support_sum += support;
-            sampled_steps += 1;
+    run_until(&mut world, end, |w| {
+        let support;
+        (estimates, support) = constraint_pressures(w);
+        for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
+            let y = p.y - tank.min.y;
+            let i = ((y / d).max(0.0) as usize).min(layers - 1);
+            sums[i].0 += v;
+            sums[i].1 += y;
+            sums[i].2 += 1;
         }
-        progress(world.time() / end);
-    }
-    let (density_error_avg, density_error_max) = world
-        .last_step()
-        .map_or((0.0, 0.0), |s| (s.density_error_avg, s.density_error_max));
+        support_sum += support;
+        sampled_steps += 1;
+        progress(w.time() / end);
+    })?;
     let rho0 = world.params().rest_density;
     let g = Vec3::from(world.params().gravity).norm();
     let floor = tank.min.y;
-    let (height, expected_height) = water_height(&world, &tank);
 
     let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
     let support = support_sum / sampled_steps.max(1) as f64;
@@ -269,10 +338,11 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         density_error_avg,
         density_error_max,
         density_error_avg_worst: worst,
-        rms_velocity: world.rms_velocity(),
+        rms_velocity,
         height,
         expected_height,
-        escaped: world.escaped_count() + world.nan_count(),
+        escaped,
+        reading_tolerance,
         pressures,
         profile,
         slope: -least_squares_slope(&fitted),
@@ -280,6 +350,17 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         hydrostatic_slope: rho0 * g,
         force_balance: support / (world.particle_mass() * g),
     })
+}
+
+/// Steps `world` until its clock reads `end` (s), the last step shortened to land on it;
+/// `each` sees the world after every step.
+fn run_until(world: &mut World, end: f64, mut each: impl FnMut(&World)) -> Result<(), Error> {
+    while end - world.time() > 1e-12 * end {
+        let dt = world.next_dt().min(end - world.time());
+        world.step_with_dt(dt)?;
+        each(world);
+    }
+    Ok(())
 }
 
 /// Pearson correlation of the pairs (NaN for fewer than two distinct values).
@@ -384,14 +465,18 @@ impl Report {
         let s = &self.setup;
         let _ = writeln!(
             out,
-            "tank at rest: {} particles ({}x{}x{}, r = {} m), {} s settling, {} solver",
+            "tank at rest: {} particles ({}x{}x{}, r = {} m), relaxed {} s at damping {}/s, \
+             then {} s free; {} solver, {} settings",
             self.particles,
             s.count[0],
             s.count[1],
             s.count[2],
             s.particle_radius,
+            s.relax,
+            s.damping,
             s.settle,
-            s.solver.name()
+            s.solver.name(),
+            if s.calm { "calm" } else { "default" }
         );
         let rows = [
             (
@@ -407,7 +492,7 @@ impl Report {
                 format!("{:.4} %", 100.0 * self.density_error_avg_worst),
             ),
             (
-                "rms velocity at the end",
+                "rms velocity after the free run",
                 format!("{:.4} m/s", self.rms_velocity),
             ),
             (
@@ -438,6 +523,13 @@ impl Report {
             (
                 "constraint force / weight",
                 format!("{:.3} (1 at the fixed point)", self.force_balance),
+            ),
+            (
+                "pressure read at",
+                format!(
+                    "tau = {:.1e} m over the {READING_WINDOW} s after the free run",
+                    self.reading_tolerance
+                ),
             ),
             ("escaped or NaN particles", self.escaped.to_string()),
         ];

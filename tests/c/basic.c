@@ -26,6 +26,17 @@ int main(int argc, char **argv) {
     params.threads = 2;
     OK(pf_params_validate(&params));
 
+    /* The calm settings change the weighting, tau and Chebyshev's settings only. */
+    PfParams calm = params;
+    OK(pf_params_calm(&calm));
+    CHECK(calm.projection_weight == PF_WEIGHT_UNIFORM);
+    CHECK(calm.displacement_tolerance == 3e-4 * params.particle_radius);
+    CHECK(calm.chebyshev_rho == 0.99 && calm.chebyshev_gamma == 0.5);
+    CHECK(calm.chebyshev_auto_rho == 0);
+    CHECK(calm.threads == 2 && calm.solver == params.solver);
+    CHECK(calm.stiffness == params.stiffness && calm.dt_max == params.dt_max);
+    OK(pf_params_validate(&calm));
+
     PfWorld *world = NULL;
     OK(pf_world_create(&params, &world));
     CHECK(world != NULL);
@@ -90,6 +101,16 @@ int main(int argc, char **argv) {
     double t2 = 0.0;
     OK(pf_world_time(world, &t2));
     CHECK(fabs(t2 - (t + 0.004)) < 1e-12);
+
+    /* Relaxing at a damping rate so high that exp(-rate dt) underflows stops every
+     * particle at the end of each step. */
+    OK(pf_world_relax(world, 0.004, 1e6));
+    OK(pf_world_time(world, &t2));
+    CHECK(fabs(t2 - (t + 0.008)) < 1e-12);
+    OK(pf_world_get_velocities(world, vel, 3 * n, NULL));
+    for (size_t i = 0; i < 3 * n; i++) CHECK(vel[i] == 0.0f);
+    OK(pf_world_advance(world, 0.004));
+    OK(pf_world_time(world, &t2));
 
     OK(pf_world_get_positions(world, pos, 3 * n, NULL));
     OK(pf_world_get_velocities(world, vel, 3 * n, NULL));

@@ -61,7 +61,17 @@ static void bad_params(PfParams p, const char *field) {
     if (strstr(pf_last_error_message(), field) == NULL)
         FAIL("the message does not name %s", field);
     CHECK(w == NULL);
-    rejected += 2;
+    /* pf_params_calm rejects them too and leaves them as they were. */
+    PfParams calm = p;
+    EXPECT(PF_ERROR_INVALID_ARGUMENT, pf_params_calm(&calm));
+    if (strstr(pf_last_error_message(), field) == NULL)
+        FAIL("the message does not name %s", field);
+    CHECK(calm.projection_weight == p.projection_weight);
+    CHECK(memcmp(&calm.displacement_tolerance, &p.displacement_tolerance, sizeof(double)) == 0);
+    CHECK(memcmp(&calm.chebyshev_rho, &p.chebyshev_rho, sizeof(double)) == 0);
+    CHECK(memcmp(&calm.chebyshev_gamma, &p.chebyshev_gamma, sizeof(double)) == 0);
+    CHECK(calm.chebyshev_auto_rho == p.chebyshev_auto_rho);
+    rejected += 3;
 }
 
 int main(void) {
@@ -120,17 +130,20 @@ int main(void) {
     PfWorld *w = NULL;
     EXPECT(PF_ERROR_NULL_POINTER, pf_params_default(NULL));
     EXPECT(PF_ERROR_NULL_POINTER, pf_params_validate(NULL));
+    EXPECT(PF_ERROR_NULL_POINTER, pf_params_calm(NULL));
     EXPECT(PF_ERROR_NULL_POINTER, pf_world_create(&params, NULL));
     w = (PfWorld *)&params;
     EXPECT(PF_ERROR_NULL_POINTER, pf_world_create(NULL, &w));
     CHECK(w == NULL);
-    rejected += 4;
+    rejected += 5;
 
-    /* --- An empty world cannot step; advancing by 0 is fine. --- */
+    /* --- An empty world cannot step; advancing or relaxing by 0 is fine. --- */
     OK(pf_world_create(&params, &w));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_step(w, 0.0));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, 0.01));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, 1.0));
     OK(pf_world_advance(w, 0.0));
+    OK(pf_world_relax(w, 0.0, 1.0));
 
     /* --- A valid world to misuse. --- */
     const float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {0.3f, 0.3f, 0.3f};
@@ -165,6 +178,7 @@ int main(void) {
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_mesh(NULL, mesh_v, 4, mesh_i, 4));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_step(NULL, 0.0));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_advance(NULL, 0.01));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_relax(NULL, 0.01, 1.0));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_count(NULL, &sz));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_boundary_count(NULL, &sz));
     REJECT(w, PF_ERROR_NULL_POINTER, pf_world_time(NULL, &t));
@@ -291,6 +305,10 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, -0.1));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, NAN));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, INFINITY));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, -0.1, 1.0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, -1.0));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, NAN));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, INFINITY));
 
     /* Calls after all those failures work normally and clear the message. */
     size_t nb = 0, nb_mesh = 0;

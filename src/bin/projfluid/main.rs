@@ -9,8 +9,9 @@
 //! projfluid scenes
 //! projfluid validate martin-moyce [--n2 2|1] [--resolution N] [--layers N] [--duration TAU]
 //!                                 [--solver S] [--threads N] [--out DIR]
-//! projfluid validate hydrostatic [--count NX,NY,NZ] [--settle SECONDS] [--tau METRES]
-//!                                [--solver S] [--threads N] [--out DIR]
+//! projfluid validate hydrostatic [--count NX,NY,NZ] [--relax SECONDS] [--damping RATE]
+//!                                [--settle SECONDS] [--settings calm|default] [--tau METRES]
+//!                                [--reading-tau METRES] [--solver S] [--threads N] [--out DIR]
 //! projfluid bench [--scenes A,B,…] [--solvers A,B,…] [--steps N] [--rho R] [--tau METRES]
 //!                 [--threads N] [--out DIR]
 //! projfluid tune-rho SCENE [--steps T] [--warmup N] [--from R] [--to R] [--step R]

@@ -64,7 +64,24 @@ pub(crate) struct HydrostaticArgs {
         value_delimiter = ','
     )]
     count: Vec<usize>,
-    /// Settling time in seconds.
+    /// Relaxation before the measured run, in seconds: the lattice is stepped with damped
+    /// velocities to find its equilibrium packing (0 releases the lattice as built).
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 10.0,
+        allow_negative_numbers = true
+    )]
+    relax: f64,
+    /// Velocity damping rate of the relaxation, in 1/s.
+    #[arg(
+        long,
+        value_name = "RATE",
+        default_value_t = 4.0,
+        allow_negative_numbers = true
+    )]
+    damping: f64,
+    /// Free settling time after the relaxation, in seconds.
     #[arg(
         long,
         value_name = "SECONDS",
@@ -72,9 +89,16 @@ pub(crate) struct HydrostaticArgs {
         allow_negative_numbers = true
     )]
     settle: f64,
-    /// Outer stopping threshold τ in metres [default: 3e-3·r].
+    /// Solver settings: `calm` (uniform weighting, γ = 0.5, ρ = 0.99, τ = 3e-4·r) or the
+    /// library's `default` ones.
+    #[arg(long, value_name = "NAME", default_value = "calm", value_parser = ["calm", "default"])]
+    settings: String,
+    /// Outer stopping threshold τ in metres [default: that of --settings].
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     tau: Option<f64>,
+    /// τ of the pressure reading after the free run, in metres [default: 1e-5·r].
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    reading_tau: Option<f64>,
     #[command(flatten)]
     common: CommonArgs,
 }
@@ -175,8 +199,12 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
     let mut setup = hydrostatic::Setup {
         solver: args.common.solver,
         threads: args.common.threads,
+        relax: args.relax,
+        damping: args.damping,
         settle: args.settle,
+        calm: args.settings == "calm",
         tolerance: args.tau,
+        reading_tolerance: args.reading_tau,
         ..hydrostatic::Setup::default()
     };
     setup.count = match args.count[..] {
@@ -196,15 +224,6 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
         }
         other => input(other),
     })?;
-    if let Some(tau) = args.tau {
-        if !(tau.is_finite() && tau > 0.0) {
-            return Err(input(Error::invalid(
-                "--tau",
-                tau,
-                "must be a positive finite number",
-            )));
-        }
-    }
     create_dir(&args.common.out)?;
     let report = hydrostatic::simulate(&setup, |_| {}).map_err(runtime)?;
     let files = hydrostatic::write_report(&args.common.out, &report).map_err(runtime)?;

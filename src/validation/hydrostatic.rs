@@ -31,7 +31,7 @@ use std::path::{Path, PathBuf};
 /// Length of the pressure reading after the free run (s).
 pub const READING_WINDOW: f64 = 0.25;
 /// τ of the pressure reading as a multiple of the particle radius: the force balance is
-/// within 3 % of the weight at 1e-5, 15 % off at 3e-5 (README, "Validation").
+/// within 3 % of the weight at 1e-5, 14 % off at 3e-5 (README, "Validation").
 pub const READING_TOLERANCE_PER_RADIUS: f64 = 1e-5;
 
 /// How the tank is set up, how it is brought to its equilibrium and how long it then runs

@@ -69,7 +69,17 @@ impl World {
     /// Steps until `seconds` more simulated time has passed; the last step is shortened to
     /// land exactly. Returns the number of steps taken.
     pub fn advance(&mut self, seconds: f64) -> Result<usize, Error> {
-        self.relax(seconds, 0.0)
+        self.advance_with(seconds, |_| Ok(()))
+    }
+
+    /// [`World::advance`], calling `each` with the world after every step; an error from
+    /// `each` ends the run there and is returned.
+    pub fn advance_with(
+        &mut self,
+        seconds: f64,
+        mut each: impl FnMut(&World) -> Result<(), Error>,
+    ) -> Result<usize, Error> {
+        self.step_for(seconds, |world, _| each(world))
     }
 
     /// Relaxes the fluid towards its equilibrium: steps like [`World::advance`] for `seconds`
@@ -79,13 +89,6 @@ impl World {
     /// and 10 s at 4/s bring a tank to its equilibrium packing (README, "A tank at rest").
     /// Returns the number of steps taken.
     pub fn relax(&mut self, seconds: f64, damping: f64) -> Result<usize, Error> {
-        if !(seconds.is_finite() && seconds >= 0.0) {
-            return Err(Error::invalid(
-                "seconds",
-                seconds,
-                "must be a non-negative finite number",
-            ));
-        }
         if !(damping.is_finite() && damping >= 0.0) {
             return Err(Error::invalid(
                 "damping",
@@ -93,17 +96,37 @@ impl World {
                 "must be a non-negative finite rate (1/s)",
             ));
         }
+        self.step_for(seconds, |world, dt| {
+            if damping > 0.0 {
+                let factor = (-damping * dt).exp();
+                for v in &mut world.fluid.velocities {
+                    *v *= factor;
+                }
+            }
+            Ok(())
+        })
+    }
+
+    /// Takes CFL-limited steps until `seconds` (≥ 0, finite) more simulated time has passed,
+    /// the last one shortened to land exactly, calling `after(world, Δt)` after every step.
+    fn step_for(
+        &mut self,
+        seconds: f64,
+        mut after: impl FnMut(&mut World, f64) -> Result<(), Error>,
+    ) -> Result<usize, Error> {
+        if !(seconds.is_finite() && seconds >= 0.0) {
+            return Err(Error::invalid(
+                "seconds",
+                seconds,
+                "must be a non-negative finite number",
+            ));
+        }
         let end = self.time + seconds;
         let mut steps = 0;
         while end - self.time > 1e-12 * end.abs().max(1.0) {
             let dt = self.next_dt.min(end - self.time);
             self.step_with_dt(dt)?;
-            if damping > 0.0 {
-                let factor = (-damping * dt).exp();
-                for v in &mut self.fluid.velocities {
-                    *v *= factor;
-                }
-            }
+            after(self, dt)?;
             steps += 1;
         }
         Ok(steps)
@@ -486,5 +509,36 @@ mod tests {
             assert!(message.contains(field), "{message}");
             assert_eq!(world.steps(), 0);
         }
+    }
+
+    /// `advance_with` takes the steps `advance` takes, shows every one to its callback, and
+    /// stops at the first error the callback returns, returning it.
+    #[test]
+    fn advance_with_sees_every_step_and_stops_on_error() {
+        let mut advanced = small_dam_break();
+        let mut observed = small_dam_break();
+        let steps = advanced.advance(0.02).unwrap();
+        let mut seen = Vec::new();
+        let count = observed
+            .advance_with(0.02, |w| {
+                seen.push(w.steps());
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(count, steps);
+        assert_eq!(seen, (1..=steps as u64).collect::<Vec<_>>());
+        assert!(advanced.positions() == observed.positions());
+        let mut stopped = small_dam_break();
+        let error = stopped
+            .advance_with(0.02, |w| {
+                if w.steps() == 2 {
+                    Err(crate::Error::invalid("probe", 2, "stops the run"))
+                } else {
+                    Ok(())
+                }
+            })
+            .unwrap_err();
+        assert!(error.to_string().contains("probe"));
+        assert_eq!(stopped.steps(), 2);
     }
 }

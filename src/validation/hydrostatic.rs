@@ -249,17 +249,17 @@ pub fn water_height(world: &World, tank: &Aabb) -> (f64, f64) {
 /// solved to `setup.reading_tolerance`; `progress` receives the fraction done as the run goes.
 pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
     let (mut world, tank) = setup.build()?;
-    let settled = setup.relax + setup.settle;
-    let end = settled + READING_WINDOW;
+    let end = setup.relax + setup.settle + READING_WINDOW;
     // The relaxation in slices of at most a quarter second, for the progress report.
     while setup.relax - world.time() > 1e-12 * setup.relax {
         world.relax((setup.relax - world.time()).min(0.25), setup.damping)?;
         progress(world.time() / end);
     }
     let mut worst: f64 = 0.0;
-    run_until(&mut world, settled, |w| {
+    world.advance_with(setup.settle, |w| {
         worst = worst.max(w.last_step().map_or(0.0, |s| s.density_error_avg));
         progress(w.time() / end);
+        Ok(())
     })?;
     let (density_error_avg, density_error_max) = world
         .last_step()
@@ -286,7 +286,7 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
     let mut sums = vec![(0.0, 0.0, 0usize); layers];
     let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
     let mut estimates = Vec::new();
-    run_until(&mut world, end, |w| {
+    world.advance_with(READING_WINDOW, |w| {
         let support;
         (estimates, support) = constraint_pressures(w);
         for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
@@ -299,6 +299,7 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         support_sum += support;
         sampled_steps += 1;
         progress(w.time() / end);
+        Ok(())
     })?;
     let rho0 = world.params().rest_density;
     let g = Vec3::from(world.params().gravity).norm();
@@ -350,17 +351,6 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         hydrostatic_slope: rho0 * g,
         force_balance: support / (world.particle_mass() * g),
     })
-}
-
-/// Steps `world` until its clock reads `end` (s), the last step shortened to land on it;
-/// `each` sees the world after every step.
-fn run_until(world: &mut World, end: f64, mut each: impl FnMut(&World)) -> Result<(), Error> {
-    while end - world.time() > 1e-12 * end {
-        let dt = world.next_dt().min(end - world.time());
-        world.step_with_dt(dt)?;
-        each(world);
-    }
-    Ok(())
 }
 
 /// Pearson correlation of the pairs (NaN for fewer than two distinct values).

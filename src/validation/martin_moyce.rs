@@ -229,9 +229,7 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Run, Err
     let g = Vec3::from(world.params().gravity).norm();
     let end = setup.duration * (COLUMN_WIDTH / g).sqrt();
     let mut samples = vec![sample(&world, &tank, d)?];
-    while end - world.time() > 1e-12 * end {
-        let dt = world.next_dt().min(end - world.time());
-        world.step_with_dt(dt)?;
+    world.advance_with(end, |world| {
         if world.nan_count() > 0 {
             return Err(Error::invalid(
                 "simulation",
@@ -239,9 +237,10 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Run, Err
                 "produced non-finite particle positions",
             ));
         }
-        samples.push(sample(&world, &tank, d)?);
+        samples.push(sample(world, &tank, d)?);
         progress(world.time() / end);
-    }
+        Ok(())
+    })?;
     Ok(Run {
         setup: setup.clone(),
         samples,

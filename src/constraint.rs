@@ -49,8 +49,8 @@ pub struct DensityConstraint {
     /// Write every projection's corrections out, as multi-step ones do (the reference path,
     /// for tests of the single-step shortcut).
     pub materialize_all: bool,
-    /// Project with the portable build even where the processor has AVX2 (for the test
-    /// that both builds agree bit for bit).
+    /// Project and gather with the portable builds even where the processor has AVX2 (for
+    /// the test that both builds agree bit for bit).
     pub portable: bool,
     /// Evaluate ρ_i after every first projection step, also where a bound already shows it
     /// is below ρ0 (for the test that skipping those evaluations changes nothing).
@@ -580,35 +580,22 @@ impl DensityConstraint {
         projections: &[Projection],
         corrections: &Corrections,
     ) -> Vec3 {
-        GATHER.with_borrow_mut(|gather| {
-            #[cfg(target_arch = "x86_64")]
-            if !self.portable && std::arch::is_x86_feature_detected!("avx2") {
-                // SAFETY: the processor supports AVX2, checked just above.
-                return unsafe {
-                    self.gathered_correction_avx2(j, x, nb, projections, corrections, gather)
-                };
-            }
-            self.gathered_correction_portable(j, x, nb, projections, corrections, gather)
-        })
+        GATHER
+            .with_borrow_mut(|gather| self.gather_into(j, x, nb, projections, corrections, gather))
     }
 
-    /// [`Self::gathered_correction_portable`] compiled for AVX2 (four lanes wide), the same
-    /// IEEE operations in the same order (tested).
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn gathered_correction_avx2(
-        &self,
-        j: usize,
-        x: &[Vec3],
-        nb: &Neighborhood,
-        projections: &[Projection],
-        corrections: &Corrections,
-        gather: &mut Gather,
-    ) -> Vec3 {
-        self.gathered_correction_portable(j, x, nb, projections, corrections, gather)
+    crate::simd::avx2_dispatch! {
+        /// [`Self::gathered_correction`] with the thread's buffers; the AVX2 build evaluates
+        /// the gradients four lanes wide, bitwise alike (tested).
+        fn gather_into / gather_into_avx2(
+            &self,
+            j: usize,
+            x: &[Vec3],
+            nb: &Neighborhood,
+            projections: &[Projection],
+            corrections: &Corrections,
+            gather: &mut Gather,
+        ) -> Vec3 where !self.portable => gathered_correction_portable
     }
 
     /// The body of [`Self::gathered_correction`]. A first pass lists, without branches, the
@@ -709,46 +696,21 @@ impl DensityConstraint {
         (grad_i, denominator + grad_i.norm_squared())
     }
 
-    /// Projection of constraint i (ALGORITHM.md §2.5): Newton-like steps on a private copy
-    /// p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after its first
-    /// step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour)
-    /// receive the corrections.
-    fn project_one(
-        &self,
-        i: usize,
-        x: &[Vec3],
-        nb: &Neighborhood,
-        dp: &mut [Vec3],
-        out: &mut Projection,
-        scratch: &mut Scratch,
-    ) {
-        #[cfg(target_arch = "x86_64")]
-        if !self.portable && std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor supports AVX2, checked just above.
-            return unsafe { self.project_one_avx2(i, x, nb, dp, out, scratch) };
-        }
-        self.project_one_portable(i, x, nb, dp, out, scratch)
-    }
-
-    /// [`Self::project_one_portable`] compiled for AVX2, so that the loops over a stencil's
-    /// members run four lanes wide. Without fused multiply-adds the arithmetic is the same
-    /// IEEE operations in the same order, so the results are bitwise those of the portable
-    /// build (tested).
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn project_one_avx2(
-        &self,
-        i: usize,
-        x: &[Vec3],
-        nb: &Neighborhood,
-        dp: &mut [Vec3],
-        out: &mut Projection,
-        scratch: &mut Scratch,
-    ) {
-        self.project_one_portable(i, x, nb, dp, out, scratch)
+    crate::simd::avx2_dispatch! {
+        /// Projection of constraint i (ALGORITHM.md §2.5): Newton-like steps on a private
+        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after
+        /// its first step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]`
+        /// (s-th neighbour) receive the corrections. The AVX2 build runs the loops over a
+        /// stencil's members four lanes wide, bitwise alike (tested).
+        fn project_one / project_one_avx2(
+            &self,
+            i: usize,
+            x: &[Vec3],
+            nb: &Neighborhood,
+            dp: &mut [Vec3],
+            out: &mut Projection,
+            scratch: &mut Scratch,
+        ) where !self.portable => project_one_portable
     }
 
     /// The body of [`Self::project_one`], inlined into both builds.

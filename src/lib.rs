@@ -27,6 +27,7 @@ pub mod params;
 pub mod plot;
 pub mod reduce;
 pub mod scene;
+mod simd;
 pub mod solver;
 pub mod stats;
 mod step;

@@ -323,25 +323,11 @@ struct Block<'a> {
 }
 
 impl Block<'_> {
-    /// Appends the neighbours of every query to `found` and their number to `counts`.
-    fn search(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
-        #[cfg(target_arch = "x86_64")]
-        if std::arch::is_x86_feature_detected!("avx2") {
-            // SAFETY: the processor supports AVX2, checked just above.
-            return unsafe { self.search_avx2(queries, counts, found) };
-        }
-        self.search_portable(queries, counts, found)
-    }
-
-    /// [`Block::search_portable`] compiled for AVX2 (four distance tests per instruction);
-    /// the same IEEE operations, so the same lists.
-    ///
-    /// # Safety
-    /// The processor must support AVX2.
-    #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2")]
-    unsafe fn search_avx2(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
-        self.search_portable(queries, counts, found)
+    crate::simd::avx2_dispatch! {
+        /// Appends the neighbours of every query to `found` and their number to `counts`
+        /// (four distance tests per instruction in the AVX2 build; the same lists).
+        fn search / search_avx2(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>)
+            where true => search_portable
     }
 
     /// The body of [`Block::search`], inlined into both builds.

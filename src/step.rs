@@ -415,11 +415,11 @@ mod tests {
         assert!(plain.velocities() == changed.velocities());
     }
 
-    /// The AVX2 build of the projection does the same IEEE operations in the same order as
-    /// the portable one, so the two give bitwise the same trajectory. (On a processor
-    /// without AVX2 both worlds take the portable path.)
+    /// The AVX2 builds of the projection and of the gather do the same IEEE operations in
+    /// the same order as the portable ones, so the two give bitwise the same trajectory. (On
+    /// a processor without AVX2 both worlds take the portable path.)
     #[test]
-    fn avx2_projection_matches_the_portable_one() {
+    fn avx2_builds_match_the_portable_ones() {
         steps_bitwise_alike(|w| w.constraint.portable = true);
     }
 

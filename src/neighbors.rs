@@ -299,6 +299,20 @@ struct Coordinates {
 }
 
 impl Coordinates {
+    /// Replaces the contents with the points of `ranges` of `points`, in that order.
+    fn copy_ranges(&mut self, points: &Coordinates, ranges: &[std::ops::Range<usize>]) {
+        for (out, from) in [
+            (&mut self.x, &points.x),
+            (&mut self.y, &points.y),
+            (&mut self.z, &points.z),
+        ] {
+            out.clear();
+            for range in ranges {
+                out.extend_from_slice(&from[range.clone()]);
+            }
+        }
+    }
+
     /// Copies `points` in.
     fn fill(&mut self, points: &[Vec3]) {
         for (axis, out) in [&mut self.x, &mut self.y, &mut self.z]
@@ -337,10 +351,13 @@ impl Block<'_> {
         let p = self.points;
         counts.clear();
         found.clear();
-        // The neighbour cells of the previous query's cell, in ascending Z-rank, so that
-        // their slot ranges come in ascending order and no list needs sorting.
+        // The points of the previous query's cell and its neighbour cells, copied in
+        // ascending Z-rank of the cells (so their indices ascend and no list needs
+        // sorting) into one run that every query of the cell tests in long loops.
         let mut cached: Option<[usize; 3]> = None;
         let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
+        let mut candidates = Coordinates::default();
+        let mut ids: Vec<u32> = Vec::new();
         for (k, q) in queries.iter().enumerate() {
             let start = found.len();
             let c = grid.cell_of(q);
@@ -357,30 +374,34 @@ impl Block<'_> {
                     }
                 }
                 ranges.sort_unstable_by_key(|r| r.start);
+                candidates.copy_ranges(p, &ranges);
+                ids.clear();
+                ids.extend(ranges.iter().flat_map(|r| r.start as u32..r.end as u32));
             }
-            let own = self.exclude_self.map(|first| first + k);
-            for range in &ranges {
+            let own = self
+                .exclude_self
+                .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
+            let cand = &candidates;
+            for lo in (0..ids.len()).step_by(64) {
                 // The distance tests of up to 64 points into the bits of a mask (they
                 // vectorise), then one push per set bit (no branch per candidate).
-                for lo in range.clone().step_by(64) {
-                    let hi = (lo + 64).min(range.end);
-                    let mut mask = 0u64;
-                    for (bit, ((x, y), z)) in p.x[lo..hi]
-                        .iter()
-                        .zip(&p.y[lo..hi])
-                        .zip(&p.z[lo..hi])
-                        .enumerate()
-                    {
-                        let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
-                        mask |= u64::from(dx * dx + dy * dy + dz * dz <= self.r2) << bit;
-                    }
-                    if let Some(own) = own.filter(|own| (lo..hi).contains(own)) {
-                        mask &= !(1 << (own - lo));
-                    }
-                    while mask != 0 {
-                        found.push((lo + mask.trailing_zeros() as usize) as u32);
-                        mask &= mask - 1;
-                    }
+                let hi = (lo + 64).min(ids.len());
+                let mut mask = 0u64;
+                for (bit, ((x, y), z)) in cand.x[lo..hi]
+                    .iter()
+                    .zip(&cand.y[lo..hi])
+                    .zip(&cand.z[lo..hi])
+                    .enumerate()
+                {
+                    let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
+                    mask |= u64::from(dx * dx + dy * dy + dz * dz <= self.r2) << bit;
+                }
+                if let Some(own) = own.filter(|own| (lo..hi).contains(own)) {
+                    mask &= !(1 << (own - lo));
+                }
+                while mask != 0 {
+                    found.push(ids[lo + mask.trailing_zeros() as usize]);
+                    mask &= mask - 1;
                 }
             }
             counts.push((found.len() - start) as u32);

@@ -1,0 +1,43 @@
+//! Run-time choice of an AVX2 build of a hot method.
+//!
+//! The hot loops (a constraint's projection, the global step's gather, a block of
+//! neighbour queries) are written once, as `#[inline(always)]` portable methods whose loops
+//! run over structures of arrays. [`avx2_dispatch!`] compiles such a method a second time
+//! with AVX2 enabled, so that those loops run four lanes wide, and picks the build at run
+//! time. Without fused multiply-adds both builds perform the same IEEE operations in the
+//! same order, so their results are bitwise the same (tested for each use).
+
+/// Defines `$name`, which calls the `#[inline(always)]` method `$portable` with the same
+/// arguments, compiled for AVX2 (as the private method `$avx2`) where the processor has AVX2
+/// and `$allow` holds, and as it is otherwise. The receiver is spelled by the caller
+/// (`&self`), so that `$allow` may read it.
+macro_rules! avx2_dispatch {
+    (
+        $(#[$doc:meta])*
+        $vis:vis fn $name:ident / $avx2:ident (&$this:ident $(, $arg:ident : $ty:ty)* $(,)?)
+            $(-> $ret:ty)? where $allow:expr => $portable:ident
+    ) => {
+        $(#[$doc])*
+        #[inline]
+        $vis fn $name(&$this $(, $arg: $ty)*) $(-> $ret)? {
+            #[cfg(target_arch = "x86_64")]
+            if $allow && std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the processor supports AVX2, checked just above.
+                return unsafe { $this.$avx2($($arg),*) };
+            }
+            $this.$portable($($arg),*)
+        }
+
+        /// The AVX2 build of the portable method this dispatches to (see `crate::simd`).
+        ///
+        /// # Safety
+        /// The processor must support AVX2.
+        #[cfg(target_arch = "x86_64")]
+        #[target_feature(enable = "avx2")]
+        unsafe fn $avx2(&$this $(, $arg: $ty)*) $(-> $ret)? {
+            $this.$portable($($arg),*)
+        }
+    };
+}
+
+pub(crate) use avx2_dispatch;

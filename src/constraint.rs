@@ -145,16 +145,24 @@ struct BoundaryMembers {
 impl BoundaryMembers {
     /// Sizes every array for `n` members.
     fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.rx,
-            &mut self.ry,
-            &mut self.rz,
-            &mut self.len,
-            &mut self.psi,
-            &mut self.values,
-        ] {
-            v.resize(n, 0.0);
-        }
+        resize_each(
+            [
+                &mut self.rx,
+                &mut self.ry,
+                &mut self.rz,
+                &mut self.len,
+                &mut self.psi,
+                &mut self.values,
+            ],
+            n,
+        );
+    }
+}
+
+/// Sizes every array of a structure of arrays for `n` members (new entries 0).
+fn resize_each<const N: usize>(arrays: [&mut Vec<f64>; N], n: usize) {
+    for v in arrays {
+        v.resize(n, 0.0);
     }
 }
 
@@ -178,19 +186,20 @@ struct Members {
 impl Members {
     /// Sizes every array for `n` members.
     fn resize(&mut self, n: usize) {
-        for v in [
-            &mut self.rx,
-            &mut self.ry,
-            &mut self.rz,
-            &mut self.len,
-            &mut self.gx,
-            &mut self.gy,
-            &mut self.gz,
-            &mut self.weights,
-            &mut self.values,
-        ] {
-            v.resize(n, 0.0);
-        }
+        resize_each(
+            [
+                &mut self.rx,
+                &mut self.ry,
+                &mut self.rz,
+                &mut self.len,
+                &mut self.gx,
+                &mut self.gy,
+                &mut self.gz,
+                &mut self.weights,
+                &mut self.values,
+            ],
+            n,
+        );
     }
 
     /// ∇_{x_j}C_i of the s-th member (1/m).
@@ -248,15 +257,16 @@ impl Gather {
     fn resize(&mut self, n: usize) {
         if self.ids.len() < n {
             self.ids.resize(n, 0);
-            for v in [
-                &mut self.lambdas,
-                &mut self.rx,
-                &mut self.ry,
-                &mut self.rz,
-                &mut self.factors,
-            ] {
-                v.resize(n, 0.0);
-            }
+            resize_each(
+                [
+                    &mut self.lambdas,
+                    &mut self.rx,
+                    &mut self.ry,
+                    &mut self.rz,
+                    &mut self.factors,
+                ],
+                n,
+            );
         }
     }
 }

@@ -356,8 +356,8 @@ impl Block<'_> {
         // sorting) into one run that every query of the cell tests in long loops.
         let mut cached: Option<[usize; 3]> = None;
         let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
-        let mut candidates = Coordinates::default();
-        let mut ids: Vec<u32> = Vec::new();
+        // The thread's buffers for that run, kept from block to block (they only grow).
+        let (mut candidates, mut ids) = CANDIDATES.take();
         for (k, q) in queries.iter().enumerate() {
             let start = found.len();
             let c = grid.cell_of(q);
@@ -406,7 +406,13 @@ impl Block<'_> {
             }
             counts.push((found.len() - start) as u32);
         }
+        CANDIDATES.set((candidates, ids));
     }
+}
+
+thread_local! {
+    /// The candidate points of a block's current cell and their indices, per thread.
+    static CANDIDATES: std::cell::Cell<(Coordinates, Vec<u32>)> = Default::default();
 }
 
 /// Interleaves the low 21 bits of x, y, z into a 63-bit Morton code.

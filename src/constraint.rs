@@ -302,21 +302,13 @@ impl DensityConstraint {
         self.mass * (k.w_zero() + fluid) + boundary
     }
 
-    /// [`Self::density_at`] at the iterate (`xi` = x_i, neighbours at `x`), keeping every
-    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. The same
-    /// density up to the order of the summation.
+    /// Fills `m` with the fluid members of stencil i, particle i at `xi` and its neighbours
+    /// at `x`: their offsets x_i − x_j and distances (m), and their kernel values W (1/m³)
+    /// in `m.values`.
     #[inline(always)]
-    fn first_density(
-        &self,
-        i: usize,
-        xi: Vec3,
-        x: &[Vec3],
-        nb: &Neighborhood,
-        scratch: &mut Scratch,
-    ) -> f64 {
+    fn fill_members(&self, i: usize, xi: Vec3, x: &[Vec3], nb: &Neighborhood, m: &mut Members) {
         let k = &self.kernel;
         let neighbors = nb.fluid.of(i);
-        let m = &mut scratch.members;
         m.resize(neighbors.len());
         for (((&j, rx), ry), rz) in neighbors
             .iter()
@@ -338,6 +330,23 @@ impl DensityConstraint {
             *len = (rx * rx + ry * ry + rz * rz).sqrt();
             *w = k.w(*len);
         }
+    }
+
+    /// [`Self::density_at`] at the iterate (`xi` = x_i, neighbours at `x`), keeping every
+    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. The same
+    /// density up to the order of the summation.
+    #[inline(always)]
+    fn first_density(
+        &self,
+        i: usize,
+        xi: Vec3,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        let k = &self.kernel;
+        let m = &mut scratch.members;
+        self.fill_members(i, xi, x, nb, m);
         let fluid = ordered_sum(&m.values);
         let walls = nb.boundary.of(i);
         let bm = &mut scratch.boundary;
@@ -492,9 +501,83 @@ impl DensityConstraint {
     pub fn densities(&self, positions: &[Vec3], nb: &Neighborhood, out: &mut Vec<f64>) {
         out.resize(positions.len(), 0.0);
         out.par_iter_mut().enumerate().for_each(|(i, rho)| {
-            let members = nb.fluid.of(i);
-            *rho = self.density_at(i, positions[i], |s| positions[members[s] as usize], nb);
+            *rho = SCRATCH.with_borrow_mut(|scratch| self.density_of(i, positions, nb, scratch));
         });
+    }
+
+    crate::simd::avx2_dispatch! {
+        /// ρ_i (kg/m³) with the particles at `x`, by [`Self::first_density`] (four lanes
+        /// wide in the AVX2 build, bitwise alike).
+        fn density_of / density_of_avx2(
+            &self,
+            i: usize,
+            x: &[Vec3],
+            nb: &Neighborhood,
+            scratch: &mut Scratch,
+        ) -> f64 where !self.portable => density_of_portable
+    }
+
+    /// The body of [`Self::density_of`].
+    #[inline(always)]
+    fn density_of_portable(
+        &self,
+        i: usize,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        scratch: &mut Scratch,
+    ) -> f64 {
+        self.first_density(i, x[i], x, nb, scratch)
+    }
+
+    /// The XSPH-filtered velocity of fluid particle i (m/s), ALGORITHM.md §1.3:
+    /// v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij, with positions `x` (m), velocities `v` (m/s)
+    /// and densities `rho` (kg/m³) of the fluid.
+    pub fn xsph_velocity(
+        &self,
+        c: f64,
+        i: usize,
+        state: (&[Vec3], &[Vec3], &[f64]),
+        nb: &Neighborhood,
+    ) -> Vec3 {
+        SCRATCH.with_borrow_mut(|scratch| self.xsph_into(c, i, state, nb, &mut scratch.members))
+    }
+
+    crate::simd::avx2_dispatch! {
+        /// [`Self::xsph_velocity`] with the thread's buffers; the AVX2 build evaluates the
+        /// kernel four lanes wide, bitwise alike (tested).
+        fn xsph_into / xsph_into_avx2(
+            &self,
+            c: f64,
+            i: usize,
+            state: (&[Vec3], &[Vec3], &[f64]),
+            nb: &Neighborhood,
+            members: &mut Members,
+        ) -> Vec3 where !self.portable => xsph_portable
+    }
+
+    /// The body of [`Self::xsph_velocity`].
+    #[inline(always)]
+    fn xsph_portable(
+        &self,
+        c: f64,
+        i: usize,
+        (x, v, rho): (&[Vec3], &[Vec3], &[f64]),
+        nb: &Neighborhood,
+        members: &mut Members,
+    ) -> Vec3 {
+        self.fill_members(i, x[i], x, nb, members);
+        let vi = v[i];
+        let sum: Vec3 = nb
+            .fluid
+            .of(i)
+            .iter()
+            .zip(&members.values)
+            .map(|(&j, w)| {
+                let j = j as usize;
+                (v[j] - vi) * (self.mass / rho[j] * w)
+            })
+            .sum();
+        vi + sum * c
     }
 
     /// The weight w_j of fluid particle j in a projection (ALGORITHM.md §2.5).

@@ -334,21 +334,16 @@ fn xsph(
     fluid: &mut crate::world::Fluid,
     scratch: &mut Vec<Vec3>,
 ) {
-    let (x, v, rho) = (&fluid.positions, &fluid.velocities, &fluid.densities);
-    scratch.resize(v.len(), Vec3::zeros());
-    scratch.par_iter_mut().enumerate().for_each(|(i, out)| {
-        let sum: Vec3 = nb
-            .fluid
-            .of(i)
-            .iter()
-            .map(|&j| {
-                let j = j as usize;
-                (v[j] - v[i])
-                    * (constraint.mass / rho[j] * constraint.kernel.w((x[i] - x[j]).norm()))
-            })
-            .sum();
-        *out = v[i] + sum * c;
-    });
+    let state = (
+        &fluid.positions[..],
+        &fluid.velocities[..],
+        &fluid.densities[..],
+    );
+    scratch.resize(fluid.velocities.len(), Vec3::zeros());
+    scratch
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(i, out)| *out = constraint.xsph_velocity(c, i, state, nb));
     std::mem::swap(&mut fluid.velocities, scratch);
 }
 
@@ -415,8 +410,9 @@ mod tests {
         assert!(plain.velocities() == changed.velocities());
     }
 
-    /// The AVX2 builds of the projection and of the gather do the same IEEE operations in
-    /// the same order as the portable ones, so the two give bitwise the same trajectory. (On
+    /// The AVX2 builds of the projection, the gather, the densities and the XSPH filter do
+    /// the same IEEE operations in the same order as the portable ones, so the two give
+    /// bitwise the same trajectory. (On
     /// a processor without AVX2 both worlds take the portable path.)
     #[test]
     fn avx2_builds_match_the_portable_ones() {

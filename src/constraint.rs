@@ -11,6 +11,13 @@ use rayon::prelude::*;
 const CONSTRAINT_GOAL: f64 = 1e-14;
 /// At most this many Newton-like steps per projection.
 const MAX_PROJECTION_STEPS: usize = 100;
+/// A stencil's members are kept in arrays padded to a multiple of this many entries, so
+/// that every loop over them runs in whole vectors of four lanes with no remainder.
+const LANES: usize = 4;
+/// The offset (m) of a padding member from its stencil's centre: far outside any kernel
+/// support, so its kernel value, gradient and weight are exactly 0 (and, being finite,
+/// 0 times it stays 0).
+const FAR: f64 = 1e10;
 /// Regularisation ε of λ = −C/(|∇C|² + ε), in m⁻².
 const REGULARIZATION: f64 = 1e-6;
 /// The bound on ρ_i after a first projection step must stay this far (relative to ρ0) below
@@ -30,6 +37,9 @@ pub struct Neighborhood<'a> {
     pub boundary_positions: &'a [Vec3],
     /// Boundary particle masses ψ_b (kg).
     pub boundary_psi: &'a [f64],
+    /// The weight w_j of every fluid particle in a projection
+    /// ([`DensityConstraint::weights`]).
+    pub weights: &'a [f64],
 }
 
 /// The fluid density constraint with the constants of the local projection.
@@ -131,9 +141,12 @@ struct Scratch {
 
 /// The boundary members of one stencil by component, as [`Members`]: offsets r = x_i − x_b
 /// (m), their lengths (m), the masses ψ_b (kg), and one value per member for
-/// [`ordered_sum`] and [`ordered_dot`].
+/// [`ordered_sum`] and [`ordered_dot`]; padded as [`Members`] (padding: offsets [`FAR`],
+/// ψ = 0).
 #[derive(Default)]
 struct BoundaryMembers {
+    /// The number of members; the arrays are used up to [`padded`]`(n)`.
+    n: usize,
     rx: Vec<f64>,
     ry: Vec<f64>,
     rz: Vec<f64>,
@@ -143,35 +156,50 @@ struct BoundaryMembers {
 }
 
 impl BoundaryMembers {
-    /// Sizes every array for `n` members.
+    /// Makes room for `n` members and pads them to [`padded`]`(n)`.
     fn resize(&mut self, n: usize) {
-        resize_each(
-            [
-                &mut self.rx,
-                &mut self.ry,
-                &mut self.rz,
-                &mut self.len,
-                &mut self.psi,
-                &mut self.values,
-            ],
-            n,
-        );
+        self.n = n;
+        let arrays = [
+            &mut self.rx,
+            &mut self.ry,
+            &mut self.rz,
+            &mut self.len,
+            &mut self.psi,
+            &mut self.values,
+        ];
+        grow_each(arrays, padded(n));
+        for k in n..padded(n) {
+            (self.rx[k], self.ry[k], self.rz[k], self.psi[k]) = (FAR, FAR, FAR, 0.0);
+        }
     }
 }
 
-/// Sizes every array of a structure of arrays for `n` members (new entries 0).
-fn resize_each<const N: usize>(arrays: [&mut Vec<f64>; N], n: usize) {
+/// `n` rounded up to a multiple of [`LANES`].
+#[inline(always)]
+fn padded(n: usize) -> usize {
+    n.next_multiple_of(LANES)
+}
+
+/// Grows every array of a structure of arrays to at least `n` entries (new entries 0). The
+/// arrays never shrink, so that stencils of varying size write no new entries.
+fn grow_each<const N: usize>(arrays: [&mut Vec<f64>; N], n: usize) {
     for v in arrays {
-        v.resize(n, 0.0);
+        if v.len() < n {
+            v.resize(n, 0.0);
+        }
     }
 }
 
 /// The fluid members of one stencil, in stencil order and by component (a structure of
 /// arrays, so that the loops over them vectorise): offsets r = x_i − x_j (m) and their
 /// lengths (m); the gradients ∇_{x_j}C_i (1/m) and weights w_j of the first step; and one
-/// value per member (kernel values or squared gradients) for [`ordered_sum`].
+/// value per member (kernel values or squared gradients) for [`ordered_sum`]. The arrays
+/// are used up to [`padded`]`(n)`: the padding members sit [`FAR`] away with weight 0, so
+/// they add exact zeros to every sum.
 #[derive(Default)]
 struct Members {
+    /// The number of members.
+    n: usize,
     rx: Vec<f64>,
     ry: Vec<f64>,
     rz: Vec<f64>,
@@ -184,22 +212,24 @@ struct Members {
 }
 
 impl Members {
-    /// Sizes every array for `n` members.
+    /// Makes room for `n` members and pads them to [`padded`]`(n)`.
     fn resize(&mut self, n: usize) {
-        resize_each(
-            [
-                &mut self.rx,
-                &mut self.ry,
-                &mut self.rz,
-                &mut self.len,
-                &mut self.gx,
-                &mut self.gy,
-                &mut self.gz,
-                &mut self.weights,
-                &mut self.values,
-            ],
-            n,
-        );
+        self.n = n;
+        let arrays = [
+            &mut self.rx,
+            &mut self.ry,
+            &mut self.rz,
+            &mut self.len,
+            &mut self.gx,
+            &mut self.gy,
+            &mut self.gz,
+            &mut self.weights,
+            &mut self.values,
+        ];
+        grow_each(arrays, padded(n));
+        for k in n..padded(n) {
+            (self.rx[k], self.ry[k], self.rz[k], self.weights[k]) = (FAR, FAR, FAR, 0.0);
+        }
     }
 
     /// ∇_{x_j}C_i of the s-th member (1/m).
@@ -222,6 +252,12 @@ fn ordered_sum(values: &[f64]) -> f64 {
         }
     }
     (partial[0] + partial[1]) + (partial[2] + partial[3]) + rest
+}
+
+/// [`ordered_sum`] of the first [`padded`]`(n)` entries of a padded member array.
+#[inline(always)]
+fn members_sum(values: &[f64], n: usize) -> f64 {
+    ordered_sum(&values[..padded(n)])
 }
 
 /// The sum of `a[k]·b[k]` in one fixed order, in four interleaved partial sums (as
@@ -257,7 +293,7 @@ impl Gather {
     fn resize(&mut self, n: usize) {
         if self.ids.len() < n {
             self.ids.resize(n, 0);
-            resize_each(
+            grow_each(
                 [
                     &mut self.lambdas,
                     &mut self.rx,
@@ -319,8 +355,7 @@ impl DensityConstraint {
             let xj = &x[j as usize];
             (*rx, *ry, *rz) = (xi.x - xj.x, xi.y - xj.y, xi.z - xj.z);
         }
-        for ((((len, w), rx), ry), rz) in m
-            .len
+        for ((((len, w), rx), ry), rz) in m.len[..padded(m.n)]
             .iter_mut()
             .zip(&mut m.values)
             .zip(&m.rx)
@@ -347,7 +382,7 @@ impl DensityConstraint {
         let k = &self.kernel;
         let m = &mut scratch.members;
         self.fill_members(i, xi, x, nb, m);
-        let fluid = ordered_sum(&m.values);
+        let fluid = members_sum(&m.values, m.n);
         let walls = nb.boundary.of(i);
         let bm = &mut scratch.boundary;
         bm.resize(walls.len());
@@ -362,8 +397,7 @@ impl DensityConstraint {
             (*rx, *ry, *rz) = (xi.x - xb.x, xi.y - xb.y, xi.z - xb.z);
             *psi = nb.boundary_psi[b as usize];
         }
-        for (((((len, w), rx), ry), rz), psi) in bm
-            .len
+        for (((((len, w), rx), ry), rz), psi) in bm.len[..padded(bm.n)]
             .iter_mut()
             .zip(&mut bm.values)
             .zip(&bm.rx)
@@ -374,7 +408,7 @@ impl DensityConstraint {
             *len = (rx * rx + ry * ry + rz * rz).sqrt();
             *w = psi * k.w(*len);
         }
-        self.mass * (k.w_zero() + fluid) + ordered_sum(&bm.values)
+        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n)
     }
 
     /// [`Self::gradients`] at the iterate, from the offsets [`Self::first_density`] kept;
@@ -384,23 +418,24 @@ impl DensityConstraint {
         let kernel = &self.kernel;
         let scale = self.mass / self.rest_density;
         let bm = &mut scratch.boundary;
-        for ((c, len), psi) in bm.values.iter_mut().zip(&bm.len).zip(&bm.psi) {
+        let lanes = padded(bm.n);
+        for ((c, len), psi) in bm.values[..lanes].iter_mut().zip(&bm.len).zip(&bm.psi) {
             *c = kernel.grad_w_coefficient(*len) * psi;
         }
         let boundary = Vec3::new(
-            ordered_dot(&bm.rx, &bm.values),
-            ordered_dot(&bm.ry, &bm.values),
-            ordered_dot(&bm.rz, &bm.values),
+            ordered_dot(&bm.rx[..lanes], &bm.values),
+            ordered_dot(&bm.ry[..lanes], &bm.values),
+            ordered_dot(&bm.rz[..lanes], &bm.values),
         ) / self.rest_density;
         let m = &mut scratch.members;
-        for ((((((gx, gy), gz), g2), rx), ry), (rz, len)) in
-            m.gx.iter_mut()
-                .zip(&mut m.gy)
-                .zip(&mut m.gz)
-                .zip(&mut m.values)
-                .zip(&m.rx)
-                .zip(&m.ry)
-                .zip(m.rz.iter().zip(&m.len))
+        for ((((((gx, gy), gz), g2), rx), ry), (rz, len)) in m.gx[..padded(m.n)]
+            .iter_mut()
+            .zip(&mut m.gy)
+            .zip(&mut m.gz)
+            .zip(&mut m.values)
+            .zip(&m.rx)
+            .zip(&m.ry)
+            .zip(m.rz.iter().zip(&m.len))
         {
             // ∇_{x_j}C_i = −(m/ρ0)∇W(x_i − x_j).
             let c = -kernel.grad_w_coefficient(*len) * scale;
@@ -410,9 +445,14 @@ impl DensityConstraint {
         for (w, &j) in m.weights.iter_mut().zip(nb.fluid.of(i)) {
             *w = self.weight_of(nb, j as usize);
         }
-        let fluid = Vec3::new(ordered_sum(&m.gx), ordered_sum(&m.gy), ordered_sum(&m.gz));
+        let n = m.n;
+        let fluid = Vec3::new(
+            members_sum(&m.gx, n),
+            members_sum(&m.gy, n),
+            members_sum(&m.gz, n),
+        );
         let grad_i = boundary - fluid;
-        (grad_i, ordered_sum(&m.values) + grad_i.norm_squared())
+        (grad_i, members_sum(&m.values, n) + grad_i.norm_squared())
     }
 
     /// ρ_i after the first projection step `first` (λ and the centre's correction), from the
@@ -423,8 +463,7 @@ impl DensityConstraint {
         let k = &self.kernel;
         let (lambda, shift) = (first.lambda, first.self_correction);
         let m = &mut scratch.members;
-        for ((((((w, weight), gx), gy), gz), rx), (ry, rz)) in m
-            .values
+        for ((((((w, weight), gx), gy), gz), rx), (ry, rz)) in m.values[..padded(m.n)]
             .iter_mut()
             .zip(&m.weights)
             .zip(&m.gx)
@@ -441,10 +480,9 @@ impl DensityConstraint {
             );
             *w = k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
-        let fluid = ordered_sum(&m.values);
+        let fluid = members_sum(&m.values, m.n);
         let bm = &mut scratch.boundary;
-        for ((((w, rx), ry), rz), psi) in bm
-            .values
+        for ((((w, rx), ry), rz), psi) in bm.values[..padded(bm.n)]
             .iter_mut()
             .zip(&bm.rx)
             .zip(&bm.ry)
@@ -454,7 +492,7 @@ impl DensityConstraint {
             let (dx, dy, dz) = (rx + shift.x, ry + shift.y, rz + shift.z);
             *w = psi * k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
-        self.mass * (k.w_zero() + fluid) + ordered_sum(&bm.values)
+        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n)
     }
 
     /// Whether the first projection step (λ, with the centre's weight `w_i` and gradient
@@ -480,19 +518,21 @@ impl DensityConstraint {
         scratch: &mut Scratch,
     ) -> bool {
         let m = &mut scratch.members;
-        for (v, w) in m.values.iter_mut().zip(&m.weights) {
+        let n = m.n;
+        for (v, w) in m.values[..padded(n)].iter_mut().zip(&m.weights) {
             *v *= w;
         }
-        let weighted = ordered_sum(&m.values);
-        for (v, w) in m.values.iter_mut().zip(&m.weights) {
+        let weighted = members_sum(&m.values, n);
+        for (v, w) in m.values[..padded(n)].iter_mut().zip(&m.weights) {
             *v *= w;
         }
-        let members_shift = lambda * lambda * ordered_sum(&m.values);
+        let members_shift = lambda * lambda * members_sum(&m.values, n);
         let grad_i2 = grad_i.norm_squared();
         let shift = lambda * lambda * w_i * w_i * grad_i2;
-        let psi = ordered_sum(&scratch.boundary.psi);
+        let bm = &scratch.boundary;
+        let psi = members_sum(&bm.psi, bm.n);
         let linear = self.rest_density * lambda * (w_i * grad_i2 + weighted);
-        let spread = 2.0 * self.mass * (m.values.len() as f64 * shift + members_shift);
+        let spread = 2.0 * self.mass * (n as f64 * shift + members_shift);
         let quadratic = 0.5 * self.kernel.curvature_bound() * (spread + psi * shift);
         rho + linear + quadratic <= self.rest_density * (1.0 - RELAXATION_MARGIN)
     }
@@ -580,14 +620,21 @@ impl DensityConstraint {
         vi + sum * c
     }
 
+    /// The weight w_j of every fluid particle j in a projection (ALGORITHM.md §2.5), given
+    /// the fluid's neighbour lists, written into `out` (for [`Neighborhood::weights`]).
+    pub fn weights(&self, lists: &NeighborLists, out: &mut Vec<f64>) {
+        out.clear();
+        out.par_extend((0..lists.len()).into_par_iter().map(|j| match self.weight {
+            ProjectionWeight::NeighborCount => (lists.count(j) + 1) as f64,
+            ProjectionWeight::Unit => 1.0,
+            ProjectionWeight::Uniform => self.rest_stencil_size,
+        }));
+    }
+
     /// The weight w_j of fluid particle j in a projection (ALGORITHM.md §2.5).
     #[inline]
     fn weight_of(&self, nb: &Neighborhood, j: usize) -> f64 {
-        match self.weight {
-            ProjectionWeight::NeighborCount => (nb.fluid.count(j) + 1) as f64,
-            ProjectionWeight::Unit => 1.0,
-            ProjectionWeight::Uniform => self.rest_stencil_size,
-        }
+        nb.weights[j]
     }
 
     /// How many stencils the global step counts particle j as a member of: n_j + 1, or c
@@ -840,7 +887,7 @@ impl DensityConstraint {
                 // A second step is needed (or requested): write the first step's corrections out.
                 dp[0] = out.self_correction;
                 let m = &scratch.members;
-                for (s, w) in m.weights.iter().enumerate() {
+                for (s, w) in m.weights[..m.n].iter().enumerate() {
                     dp[s + 1] = m.gradient(s) * (out.lambda * w);
                 }
                 materialized = true;
@@ -950,11 +997,14 @@ mod tests {
             (0.75, 0.0),
         ] {
             let (x, fl, bl, bx, psi) = cluster(&constraint, 2.0 * r * factor);
+            let mut weights = Vec::new();
+            constraint.weights(&fl, &mut weights);
             let nb = Neighborhood {
                 fluid: &fl,
                 boundary: &bl,
                 boundary_positions: &bx,
                 boundary_psi: &psi,
+                weights: &weights,
             };
             let (mut active, mut certified) = (0, 0);
             for i in 0..x.len() {

@@ -30,6 +30,8 @@ pub(crate) struct StepBuffers {
     table: CellTable,
     fluid_lists: NeighborLists,
     boundary_lists: NeighborLists,
+    /// The projection weight w_j of every fluid particle.
+    weights: Vec<f64>,
     system: DiagonalSystem,
     scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
@@ -206,11 +208,13 @@ impl World {
             b.previous.clone_from(&b.predicted);
             b.next.resize(b.predicted.len(), Vec3::zeros());
             b.rhs.resize(b.predicted.len(), Vec3::zeros());
+            constraint.weights(&b.fluid_lists, &mut b.weights);
             let nb = Neighborhood {
                 fluid: &b.fluid_lists,
                 boundary: &b.boundary_lists,
                 boundary_positions: &boundary.positions,
                 boundary_psi: &boundary.psi,
+                weights: &b.weights,
             };
             chebyshev.reset();
             let chebyshev_step = params.solver == SolverKind::Chebyshev;

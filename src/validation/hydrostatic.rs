@@ -414,11 +414,14 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
             (NeighborLists::default(), NeighborLists::default());
         grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
         grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
+        let mut weights = Vec::new();
+        world.constraint.weights(&fluid_lists, &mut weights);
         let nb = Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,
             boundary_positions: &bx,
             boundary_psi: &psi,
+            weights: &weights,
         };
         let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
         world

@@ -376,7 +376,9 @@ impl Block<'_> {
                 ranges.sort_unstable_by_key(|r| r.start);
                 candidates.copy_ranges(p, &ranges);
                 ids.clear();
-                ids.extend(ranges.iter().flat_map(|r| r.start as u32..r.end as u32));
+                for r in &ranges {
+                    ids.extend(r.start as u32..r.end as u32);
+                }
             }
             let own = self
                 .exclude_self

@@ -659,32 +659,38 @@ impl DensityConstraint {
         projections: &mut Vec<Projection>,
         corrections: &mut Corrections,
     ) {
-        projections.resize(x.len(), Projection::default());
-        projections.par_iter_mut().enumerate().for_each(|(i, out)| {
-            SCRATCH.with_borrow_mut(|scratch| {
-                // Corrections written here are dropped; the buffer only grows.
-                let mut dp = std::mem::take(&mut scratch.dp);
-                let members = nb.fluid.count(i) + 1;
-                if dp.len() < members {
-                    dp.resize(members, Vec3::zeros());
-                }
-                self.project_one(i, x, nb, &mut dp[..members], out, scratch);
-                scratch.dp = dp;
-            })
-        });
-
         let c = corrections;
-        c.lambdas.resize(projections.len(), 0.0);
-        c.lambdas
+        projections.resize(x.len(), Projection::default());
+        c.lambdas.resize(x.len(), 0.0);
+        projections
             .par_iter_mut()
-            .zip(projections.par_iter())
-            .for_each(|(lambda, p)| *lambda = if p.materialized { 0.0 } else { p.lambda });
+            .zip(c.lambdas.par_iter_mut())
+            .enumerate()
+            .for_each(|(i, (out, lambda))| {
+                SCRATCH.with_borrow_mut(|scratch| {
+                    // Corrections written here are dropped; the buffer only grows.
+                    let mut dp = std::mem::take(&mut scratch.dp);
+                    let members = nb.fluid.count(i) + 1;
+                    if dp.len() < members {
+                        dp.resize(members, Vec3::zeros());
+                    }
+                    self.project_one(i, x, nb, &mut dp[..members], out, scratch);
+                    scratch.dp = dp;
+                });
+                *lambda = if out.materialized { 0.0 } else { out.lambda };
+            });
+
         c.owners.clear();
-        c.owners.extend(
-            (0..projections.len() as u32).filter(|&i| projections[i as usize].materialized),
+        c.owners.par_extend(
+            (0..projections.len() as u32)
+                .into_par_iter()
+                .filter(|&i| projections[i as usize].materialized),
         );
-        c.near_kept.clear();
-        c.near_kept.resize(projections.len(), false);
+        // The flags are cleared only when some were set (projections keep a segment rarely).
+        if c.near_kept.len() != projections.len() || c.near_kept.contains(&true) {
+            c.near_kept.clear();
+            c.near_kept.resize(projections.len(), false);
+        }
         for &i in &c.owners {
             for &j in nb.fluid.of(i as usize) {
                 c.near_kept[j as usize] = true;

@@ -159,18 +159,13 @@ impl BoundaryMembers {
     /// Makes room for `n` members and pads them to [`padded`]`(n)`.
     fn resize(&mut self, n: usize) {
         self.n = n;
-        let arrays = [
-            &mut self.rx,
-            &mut self.ry,
-            &mut self.rz,
-            &mut self.len,
-            &mut self.psi,
-            &mut self.values,
+        let padding = [
+            (&mut self.rx, FAR),
+            (&mut self.ry, FAR),
+            (&mut self.rz, FAR),
+            (&mut self.psi, 0.0),
         ];
-        grow_each(arrays, padded(n));
-        for k in n..padded(n) {
-            (self.rx[k], self.ry[k], self.rz[k], self.psi[k]) = (FAR, FAR, FAR, 0.0);
-        }
+        pad_each(padding, [&mut self.len, &mut self.values], n);
     }
 }
 
@@ -180,14 +175,25 @@ fn padded(n: usize) -> usize {
     n.next_multiple_of(LANES)
 }
 
-/// Grows every array of a structure of arrays to at least `n` entries (new entries 0). The
-/// arrays never shrink, so that stencils of varying size write no new entries.
-fn grow_each<const N: usize>(arrays: [&mut Vec<f64>; N], n: usize) {
-    for v in arrays {
-        if v.len() < n {
-            v.resize(n, 0.0);
+/// Grows the arrays of a structure of arrays to at least [`padded`]`(n)` entries and
+/// writes each `padding` array's value into its entries `n..padded(n)` (the `computed`
+/// arrays are written over the padded range before they are read). The arrays never
+/// shrink, so that stencils of varying size write no new entries.
+fn pad_each<const P: usize, const C: usize>(
+    padding: [(&mut Vec<f64>, f64); P],
+    computed: [&mut Vec<f64>; C],
+    n: usize,
+) {
+    let grow = |v: &mut Vec<f64>| {
+        if v.len() < padded(n) {
+            v.resize(padded(n), 0.0);
         }
+    };
+    for (v, pad) in padding {
+        grow(v);
+        v[n..padded(n)].fill(pad);
     }
+    computed.into_iter().for_each(grow);
 }
 
 /// The fluid members of one stencil, in stencil order and by component (a structure of
@@ -215,21 +221,20 @@ impl Members {
     /// Makes room for `n` members and pads them to [`padded`]`(n)`.
     fn resize(&mut self, n: usize) {
         self.n = n;
-        let arrays = [
-            &mut self.rx,
-            &mut self.ry,
-            &mut self.rz,
+        let padding = [
+            (&mut self.rx, FAR),
+            (&mut self.ry, FAR),
+            (&mut self.rz, FAR),
+            (&mut self.weights, 0.0),
+        ];
+        let computed = [
             &mut self.len,
             &mut self.gx,
             &mut self.gy,
             &mut self.gz,
-            &mut self.weights,
             &mut self.values,
         ];
-        grow_each(arrays, padded(n));
-        for k in n..padded(n) {
-            (self.rx[k], self.ry[k], self.rz[k], self.weights[k]) = (FAR, FAR, FAR, 0.0);
-        }
+        pad_each(padding, computed, n);
     }
 
     /// ∇_{x_j}C_i of the s-th member (1/m).
@@ -293,16 +298,14 @@ impl Gather {
     fn resize(&mut self, n: usize) {
         if self.ids.len() < n {
             self.ids.resize(n, 0);
-            grow_each(
-                [
-                    &mut self.lambdas,
-                    &mut self.rx,
-                    &mut self.ry,
-                    &mut self.rz,
-                    &mut self.factors,
-                ],
-                n,
-            );
+            let arrays = [
+                &mut self.lambdas,
+                &mut self.rx,
+                &mut self.ry,
+                &mut self.rz,
+                &mut self.factors,
+            ];
+            pad_each([], arrays, n);
         }
     }
 }
@@ -934,13 +937,33 @@ mod tests {
     use super::*;
     use crate::neighbors::{CellTable, UniformGrid};
 
+    /// Fluid positions (m) with their neighbour lists among the fluid and the boundary, the
+    /// boundary positions (m) and masses ψ (kg), and the fluid's projection weights.
+    struct Cluster {
+        x: Vec<Vec3>,
+        fl: NeighborLists,
+        bl: NeighborLists,
+        bx: Vec<Vec3>,
+        psi: Vec<f64>,
+        weights: Vec<f64>,
+    }
+
+    impl Cluster {
+        /// What the constraints of the cluster read.
+        fn nb(&self) -> Neighborhood<'_> {
+            Neighborhood {
+                fluid: &self.fl,
+                boundary: &self.bl,
+                boundary_positions: &self.bx,
+                boundary_psi: &self.psi,
+                weights: &self.weights,
+            }
+        }
+    }
+
     /// A jittered cubic lattice of 7³ particles at `spacing` (m) above a floor of boundary
-    /// particles, searched with radius H; returns (fluid positions, neighbour lists of the
-    /// fluid, of the boundary, boundary positions, ψ).
-    fn cluster(
-        constraint: &DensityConstraint,
-        spacing: f64,
-    ) -> (Vec<Vec3>, NeighborLists, NeighborLists, Vec<Vec3>, Vec<f64>) {
+    /// particles, searched with radius H.
+    fn cluster(constraint: &DensityConstraint, spacing: f64) -> Cluster {
         let h = constraint.kernel.support_radius();
         let mut seed = 7u64;
         let mut jitter = || {
@@ -973,7 +996,16 @@ mod tests {
         let (mut fl, mut bl) = (NeighborLists::default(), NeighborLists::default());
         grid.search(&fluid_table, &x, &x, h, true, &mut fl);
         grid.search(&boundary_table, &bx, &x, h, false, &mut bl);
-        (x, fl, bl, bx, psi)
+        let mut weights = Vec::new();
+        constraint.weights(&fl, &mut weights);
+        Cluster {
+            x,
+            fl,
+            bl,
+            bx,
+            psi,
+            weights,
+        }
     }
 
     /// The constraint of a fluid with particle radius `r` (m), rest density 1000 kg/m³ and
@@ -1004,22 +1036,20 @@ mod tests {
                 portable,
                 ..test_constraint(r)
             };
-            let (x, fl, bl, bx, psi) = cluster(&constraint, 2.0 * r * 0.999);
-            let mut weights = Vec::new();
-            constraint.weights(&fl, &mut weights);
-            let nb = Neighborhood {
-                fluid: &fl,
-                boundary: &bl,
-                boundary_positions: &bx,
-                boundary_psi: &psi,
-                weights: &weights,
-            };
+            let cluster = cluster(&constraint, 2.0 * r * 0.999);
+            let (x, fl, bx, psi, nb) = (
+                &cluster.x,
+                &cluster.fl,
+                &cluster.bx,
+                &cluster.psi,
+                cluster.nb(),
+            );
             let (k, h) = (&constraint.kernel, constraint.kernel.support_radius());
             let v: Vec<Vec3> = (0..x.len())
                 .map(|i| Vec3::new((i % 7) as f64, (i % 5) as f64, (i % 3) as f64) * 0.1)
                 .collect();
             let mut rho = Vec::new();
-            constraint.densities(&x, &nb, &mut rho);
+            constraint.densities(x, &nb, &mut rho);
             let mut remainders = [0usize; 4];
             let mut scratch = Scratch::default();
             for i in 0..x.len() {
@@ -1045,7 +1075,7 @@ mod tests {
                         .map(|&b| k.grad_w(&(x[i] - bx[b])) * psi[b])
                         .sum::<Vec3>();
                 let grad_direct = grad_direct / constraint.rest_density;
-                constraint.first_density(i, x[i], &x, &nb, &mut scratch);
+                constraint.first_density(i, x[i], x, &nb, &mut scratch);
                 let (grad_i, _) = constraint.first_gradients(i, &nb, &mut scratch);
                 assert!(
                     (grad_i - grad_direct).norm() <= 1e-12 * grad_direct.norm().max(1.0),
@@ -1059,7 +1089,7 @@ mod tests {
                         })
                         .sum::<Vec3>()
                         * 0.1;
-                let xsph = constraint.xsph_velocity(0.1, i, (&x, &v, &rho), &nb);
+                let xsph = constraint.xsph_velocity(0.1, i, (x, &v, &rho), &nb);
                 assert!((xsph - xsph_direct).norm() <= 1e-12, "XSPH v_{i}");
             }
             assert!(remainders.iter().all(|&n| n > 0), "{remainders:?}");
@@ -1083,19 +1113,11 @@ mod tests {
             (0.995, 1.0),
             (0.75, 0.0),
         ] {
-            let (x, fl, bl, bx, psi) = cluster(&constraint, 2.0 * r * factor);
-            let mut weights = Vec::new();
-            constraint.weights(&fl, &mut weights);
-            let nb = Neighborhood {
-                fluid: &fl,
-                boundary: &bl,
-                boundary_positions: &bx,
-                boundary_psi: &psi,
-                weights: &weights,
-            };
+            let cluster = cluster(&constraint, 2.0 * r * factor);
+            let (x, nb) = (&cluster.x, cluster.nb());
             let (mut active, mut certified) = (0, 0);
             for i in 0..x.len() {
-                let rho = constraint.first_density(i, x[i], &x, &nb, &mut scratch);
+                let rho = constraint.first_density(i, x[i], x, &nb, &mut scratch);
                 let c = (rho / constraint.rest_density - 1.0).max(0.0);
                 if c <= CONSTRAINT_GOAL {
                     continue;

@@ -416,8 +416,8 @@ mod tests {
 
     /// The AVX2 builds of the projection, the gather, the densities and the XSPH filter do
     /// the same IEEE operations in the same order as the portable ones, so the two give
-    /// bitwise the same trajectory. (On
-    /// a processor without AVX2 both worlds take the portable path.)
+    /// bitwise the same trajectory. (On a processor without AVX2 both worlds take the
+    /// portable path.)
     #[test]
     fn avx2_builds_match_the_portable_ones() {
         steps_bitwise_alike(|w| w.constraint.portable = true);

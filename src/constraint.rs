@@ -683,14 +683,16 @@ impl DensityConstraint {
                 *lambda = if out.materialized { 0.0 } else { out.lambda };
             });
 
+        // The flags were set only if the last local step kept a segment (rarely); only then
+        // are they cleared.
+        let flags_set = !c.owners.is_empty();
         c.owners.clear();
         c.owners.par_extend(
             (0..projections.len() as u32)
                 .into_par_iter()
                 .filter(|&i| projections[i as usize].materialized),
         );
-        // The flags are cleared only when some were set (projections keep a segment rarely).
-        if c.near_kept.len() != projections.len() || c.near_kept.contains(&true) {
+        if c.near_kept.len() != projections.len() || flags_set {
             c.near_kept.clear();
             c.near_kept.resize(projections.len(), false);
         }

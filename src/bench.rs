@@ -2,12 +2,13 @@
 //! parameters and stopping rule, the first N steps; a table of cost, accuracy and an
 //! "artifacts" verdict, written as Markdown and CSV, and bar charts of time and iterations.
 
-use crate::driver::{self, RunLength};
+use crate::driver::{RunError, RunLength, Runner};
 use crate::plot::BarChart;
 use crate::scene::Scene;
 use crate::stats::RunSummary;
 use crate::table::{self, Cell, Column};
 use crate::{Error, SolverKind};
+use std::convert::Infallible;
 use std::fmt;
 
 /// The paper's protocol: the mean over the first 80 time steps.
@@ -118,34 +119,84 @@ pub enum BenchEvent<'a> {
     Done(&'a BenchRow),
 }
 
+/// Steps each solver runs before the next one takes its turn ([`run_bench`]'s `turn`).
+pub const DEFAULT_TURN: u64 = 10;
+
 /// Runs every scene with every solver for `steps` steps, each from the scene's initial state
 /// with the scene's parameters except the solver, and returns one row per run, scenes outer,
 /// solvers inner, in the given orders.
+///
+/// The solvers of a scene take turns of `turn` steps each, round after round, so that a
+/// machine whose speed drifts (other programs, a shared host) slows them alike and the ratios
+/// of their times hold; every world is then in memory at once. With `turn` 0 each solver runs
+/// to the end before the next starts, one world at a time. The turns change no result but the
+/// times: each world steps exactly as it would alone.
 pub fn run_bench(
     scenes: &[Scene],
     solvers: &[SolverKind],
     steps: u64,
+    turn: u64,
     mut on_event: impl FnMut(BenchEvent<'_>),
 ) -> Result<Vec<BenchRow>, Error> {
     let mut rows = Vec::with_capacity(scenes.len() * solvers.len());
     for scene in scenes {
-        for &solver in solvers {
-            on_event(BenchEvent::Start {
-                scene: &scene.name,
-                solver,
-            });
-            let mut scene = scene.clone();
-            scene.params.solver = solver;
-            let mut world = scene.build_world()?;
-            let acc = driver::run_quietly(&mut world, RunLength::Steps(steps))?;
-            let summary = acc.summary(&scene.name, &world);
-            let row = BenchRow {
-                artifacts: artifacts(&summary),
-                summary,
-            };
-            on_event(BenchEvent::Done(&row));
-            rows.push(row);
+        if turn == 0 {
+            for solver in solvers {
+                let group = std::slice::from_ref(solver);
+                rows.extend(run_in_turns(scene, group, steps, steps, &mut on_event)?);
+            }
+        } else {
+            rows.extend(run_in_turns(scene, solvers, steps, turn, &mut on_event)?);
         }
+    }
+    Ok(rows)
+}
+
+/// Runs `scene` with every solver of `solvers` for `steps` steps, in turns of `turn` steps.
+fn run_in_turns(
+    scene: &Scene,
+    solvers: &[SolverKind],
+    steps: u64,
+    turn: u64,
+    on_event: &mut impl FnMut(BenchEvent<'_>),
+) -> Result<Vec<BenchRow>, Error> {
+    let mut runs = Vec::with_capacity(solvers.len());
+    for &solver in solvers {
+        on_event(BenchEvent::Start {
+            scene: &scene.name,
+            solver,
+        });
+        let mut scene = scene.clone();
+        scene.params.solver = solver;
+        let world = scene.build_world()?;
+        let runner = Runner::new(&world, RunLength::Steps(steps))?;
+        runs.push((world, runner));
+    }
+    let mut stepping = true;
+    while stepping {
+        stepping = false;
+        for (world, runner) in &mut runs {
+            for _ in 0..turn {
+                let step = runner.steps() + 1;
+                match runner.step(world) {
+                    Ok(Some(_)) => stepping = true,
+                    Ok(None) => break,
+                    Err(error) => {
+                        return Err(RunError::<Infallible>::Step { step, error }.into());
+                    }
+                }
+            }
+        }
+    }
+    let mut rows = Vec::with_capacity(runs.len());
+    for (world, runner) in runs {
+        let summary = runner.finish().summary(&scene.name, &world);
+        let row = BenchRow {
+            artifacts: artifacts(&summary),
+            summary,
+        };
+        on_event(BenchEvent::Done(&row));
+        rows.push(row);
     }
     Ok(rows)
 }
@@ -319,6 +370,59 @@ mod tests {
             row.verdict()
                 .starts_with("2 NaN; 3 escaped; avg density error 0.200 %")
         );
+    }
+
+    /// Taking turns changes no result but the times: every world steps as it would alone,
+    /// with its own energy datum and statistics.
+    #[test]
+    fn solvers_taking_turns_match_solvers_run_one_after_another() {
+        let mut scene = Scene::builtin("dam_break_small").unwrap();
+        scene.params.threads = 1;
+        let solvers = [SolverKind::Chebyshev, SolverKind::Cg, SolverKind::Jacobi1];
+        let run = |turn| {
+            let mut events = Vec::new();
+            let rows = run_bench(std::slice::from_ref(&scene), &solvers, 16, turn, |e| {
+                events.push(match e {
+                    BenchEvent::Start { solver, .. } => format!("start {}", solver.name()),
+                    BenchEvent::Done(row) => format!("done {}", row.summary.solver),
+                })
+            })
+            .unwrap();
+            let untimed: Vec<RunSummary> = rows
+                .into_iter()
+                .map(|r| RunSummary {
+                    wall_ms_per_step: 0.0,
+                    cpu_ms_per_step: None,
+                    ms_per_step_breakdown: [0.0; 4],
+                    ..r.summary
+                })
+                .collect();
+            (untimed, events)
+        };
+        let (alone, events) = run(0);
+        assert_eq!(
+            events,
+            ["start chebyshev", "done chebyshev", "start cg", "done cg"]
+                .into_iter()
+                .chain(["start jacobi1", "done jacobi1"])
+                .collect::<Vec<_>>()
+        );
+        assert!(
+            alone
+                .iter()
+                .all(|s| s.steps == 16 && s.outer_iterations_mean > 1.0)
+        );
+        assert_ne!(alone[0].positions_hash, alone[1].positions_hash);
+        // Turns of 5 steps (the last one short), and turns longer than the run.
+        for turn in [5, 100] {
+            let (turns, events) = run(turn);
+            assert_eq!(turns, alone, "turn {turn}");
+            assert_eq!(
+                events[..3],
+                ["start chebyshev", "start cg", "start jacobi1"]
+            );
+            assert_eq!(events[3..], ["done chebyshev", "done cg", "done jacobi1"]);
+        }
     }
 
     #[test]

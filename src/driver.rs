@@ -75,80 +75,146 @@ impl From<RunError<std::convert::Infallible>> for Error {
     }
 }
 
-/// Runs `world` for `length`, calling `on_step` after every step, and returns the statistics
-/// of the steps taken, with the total energy (above [`energy_datum`] of the world as it was
-/// at the start) recorded before the first step and after each one. Only the step itself is
-/// timed, not the energy or the callback. Stops at the first failing step or callback error.
-pub fn run<E>(
-    world: &mut World,
+/// A run in progress: the statistics of the steps taken so far, with the total energy (above
+/// [`energy_datum`] of the world as it was at the start) recorded before the first step and
+/// after each one. [`run`] drives one to its end; several can take turns on their own worlds
+/// (the benchmark interleaves its solvers this way). Only the step itself is timed, not the
+/// energy.
+pub struct Runner {
     length: RunLength,
-    mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
-) -> Result<RunAccumulator, RunError<E>> {
-    if let RunLength::Duration(d) | RunLength::UntilTime(d) = length {
-        if !(d.is_finite() && d >= 0.0) {
-            return Err(RunError::Step {
-                step: 1,
-                error: Error::invalid("duration", d, "must be a non-negative finite number"),
-            });
+    datum: f64,
+    start_time: f64,
+    start_steps: u64,
+    acc: RunAccumulator,
+}
+
+/// One step taken by [`Runner::step`].
+pub struct StepTaken {
+    /// The step's statistics.
+    pub stats: StepStats,
+    /// Wall-clock time of the step alone (s).
+    pub wall_seconds: f64,
+    /// Processor time of the step alone, all threads of the process (s), where available.
+    pub cpu_seconds: Option<f64>,
+    /// Finished fraction of the run, in [0, 1].
+    pub done: f64,
+}
+
+impl Runner {
+    /// Starts a run of `world` for `length`; a duration or end time that is negative or not
+    /// finite is an error.
+    pub fn new(world: &World, length: RunLength) -> Result<Self, Error> {
+        if let RunLength::Duration(d) | RunLength::UntilTime(d) = length {
+            if !(d.is_finite() && d >= 0.0) {
+                return Err(Error::invalid(
+                    "duration",
+                    d,
+                    "must be a non-negative finite number",
+                ));
+            }
+        }
+        let datum = energy_datum(world);
+        let mut acc = RunAccumulator::default();
+        acc.record_energy(total_energy(world, datum));
+        Ok(Self {
+            length,
+            datum,
+            start_time: world.time(),
+            start_steps: world.steps(),
+            acc,
+        })
+    }
+
+    /// The step size (s) of the run's next step, or `None` once the run has reached its end.
+    fn next_dt(&self, world: &World) -> Option<f64> {
+        let until = |end: f64| {
+            let left = end - world.time();
+            (left > 1e-12 * end.abs().max(1.0)).then(|| world.next_dt().min(left))
+        };
+        match self.length {
+            RunLength::Steps(n) => (self.acc.steps() < n).then(|| world.next_dt()),
+            RunLength::UntilStep(n) => (world.steps() < n).then(|| world.next_dt()),
+            RunLength::Duration(d) => until(self.start_time + d),
+            RunLength::UntilTime(end) => until(end),
         }
     }
-    let datum = energy_datum(world);
-    let mut acc = RunAccumulator::default();
-    acc.record_energy(total_energy(world, datum));
-    let (start, start_steps) = (world.time(), world.steps());
-    let until = |world: &World, end: f64| {
-        let left = end - world.time();
-        (left > 1e-12 * end.abs().max(1.0)).then(|| world.next_dt().min(left))
-    };
-    loop {
-        let dt = match length {
-            RunLength::Steps(n) if acc.steps() >= n => break,
-            RunLength::UntilStep(n) if world.steps() >= n => break,
-            RunLength::Steps(_) | RunLength::UntilStep(_) => world.next_dt(),
-            RunLength::Duration(d) => match until(world, start + d) {
-                Some(dt) => dt,
-                None => break,
-            },
-            RunLength::UntilTime(end) => match until(world, end) {
-                Some(dt) => dt,
-                None => break,
-            },
+
+    /// Takes the run's next step of `world` (the world it started with), or returns `None`
+    /// once the run has reached its end.
+    pub fn step(&mut self, world: &mut World) -> Result<Option<StepTaken>, Error> {
+        let Some(dt) = self.next_dt(world) else {
+            return Ok(None);
         };
         let (clock, cpu) = (Instant::now(), process_cpu_seconds());
-        let stats = match world.step_with_dt(dt) {
-            Ok(stats) => stats.clone(),
-            Err(error) => {
-                let step = acc.steps() + 1;
-                return Err(RunError::Step { step, error });
-            }
-        };
+        let stats = world.step_with_dt(dt)?.clone();
         let wall_seconds = clock.elapsed().as_secs_f64();
         let cpu_seconds = cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a);
+        let acc = &mut self.acc;
         acc.add(&stats, wall_seconds);
         if let Some(cpu) = cpu_seconds {
             acc.add_cpu_time(cpu);
         }
-        acc.record_energy(total_energy(world, datum));
-        let done = match length {
+        acc.record_energy(total_energy(world, self.datum));
+        let start = self.start_time;
+        let done = match self.length {
             RunLength::Steps(n) => acc.steps() as f64 / n as f64,
             RunLength::UntilStep(n) => {
-                (world.steps() - start_steps) as f64 / n.saturating_sub(start_steps).max(1) as f64
+                let total = n.saturating_sub(self.start_steps).max(1);
+                (world.steps() - self.start_steps) as f64 / total as f64
             }
             RunLength::Duration(d) if d > 0.0 => (world.time() - start) / d,
             RunLength::UntilTime(end) if end > start => (world.time() - start) / (end - start),
             RunLength::Duration(_) | RunLength::UntilTime(_) => 1.0,
         };
-        let report = StepReport {
-            world,
-            stats: &stats,
+        Ok(Some(StepTaken {
+            stats,
             wall_seconds,
             cpu_seconds,
-            steps: acc.steps(),
             done: done.clamp(0.0, 1.0),
+        }))
+    }
+
+    /// Steps taken so far.
+    pub fn steps(&self) -> u64 {
+        self.acc.steps()
+    }
+
+    /// Ends the run and returns the statistics of its steps.
+    pub fn finish(self) -> RunAccumulator {
+        self.acc
+    }
+}
+
+/// Runs `world` for `length` with a [`Runner`], calling `on_step` after every step, and
+/// returns the statistics of the steps taken. Stops at the first failing step or callback
+/// error.
+pub fn run<E>(
+    world: &mut World,
+    length: RunLength,
+    mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
+) -> Result<RunAccumulator, RunError<E>> {
+    let mut runner =
+        Runner::new(world, length).map_err(|error| RunError::Step { step: 1, error })?;
+    loop {
+        let taken = match runner.step(world) {
+            Ok(Some(taken)) => taken,
+            Ok(None) => break,
+            Err(error) => {
+                let step = runner.steps() + 1;
+                return Err(RunError::Step { step, error });
+            }
+        };
+        let report = StepReport {
+            world,
+            stats: &taken.stats,
+            wall_seconds: taken.wall_seconds,
+            cpu_seconds: taken.cpu_seconds,
+            steps: runner.steps(),
+            done: taken.done,
         };
         on_step(&report).map_err(RunError::Callback)?;
     }
-    Ok(acc)
+    Ok(runner.finish())
 }
 
 /// Processor time (s) used so far by all threads of this process, user plus system.

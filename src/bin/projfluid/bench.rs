@@ -21,6 +21,12 @@ pub(crate) struct BenchArgs {
     /// Time steps per run; the paper averages over the first 80.
     #[arg(long, value_name = "N", default_value_t = bench::DEFAULT_STEPS)]
     steps: u64,
+    /// Steps each solver runs before the next takes its turn, round after round, so that a
+    /// drift in the machine's speed slows all solvers alike; 0 runs each solver to the end
+    /// before the next starts (one scene's world in memory at a time instead of one per
+    /// solver).
+    #[arg(long, value_name = "N", default_value_t = bench::DEFAULT_TURN)]
+    turn: u64,
     #[command(flatten)]
     params: ParamOptions,
     /// Directory for bench.md, bench.csv, bench.png and bench_iterations.png, created if missing.
@@ -55,17 +61,25 @@ pub(crate) fn bench(args: &BenchArgs) -> Result<(), Failure> {
     };
     // Create the output directory first, so that an unwritable path fails before the runs.
     create_dir(&args.out)?;
-    let rows = bench::run_bench(&scenes, &solvers, args.steps, |event| match event {
-        BenchEvent::Start { scene, solver } => {
-            eprintln!("{scene} {}: {} steps…", solver.name(), args.steps)
-        }
-        BenchEvent::Done(row) => eprintln!(
-            "  {:.2} ms/step, {:.2} outer iterations/step, artifacts: {}",
-            row.summary.wall_ms_per_step,
-            row.summary.outer_iterations_mean,
-            row.verdict()
-        ),
-    })
+    let rows = bench::run_bench(
+        &scenes,
+        &solvers,
+        args.steps,
+        args.turn,
+        |event| match event {
+            BenchEvent::Start { scene, solver } => {
+                eprintln!("{scene} {}: {} steps…", solver.name(), args.steps)
+            }
+            BenchEvent::Done(row) => eprintln!(
+                "  {} {}: {:.2} ms/step, {:.2} outer iterations/step, artifacts: {}",
+                row.summary.scene,
+                row.summary.solver,
+                row.summary.wall_ms_per_step,
+                row.summary.outer_iterations_mean,
+                row.verdict()
+            ),
+        },
+    )
     .map_err(|e| Failure::Runtime(e.to_string()))?;
     let table = bench::markdown(&rows);
     print(&table)?;

@@ -157,6 +157,7 @@ struct BoundaryMembers {
 
 impl BoundaryMembers {
     /// Makes room for `n` members and pads them to [`padded`]`(n)`.
+    #[inline(always)]
     fn resize(&mut self, n: usize) {
         self.n = n;
         let padding = [
@@ -175,23 +176,26 @@ fn padded(n: usize) -> usize {
     n.next_multiple_of(LANES)
 }
 
-/// Grows the arrays of a structure of arrays to at least [`padded`]`(n)` entries and
-/// writes each `padding` array's value into its entries `n..padded(n)` (the `computed`
-/// arrays are written over the padded range before they are read). The arrays never
-/// shrink, so that stencils of varying size write no new entries.
+/// Grows the arrays of a structure of arrays to at least `n` + [`LANES`] entries (more than
+/// [`padded`]`(n)`) and writes each `padding` array's value into its entries
+/// `n..n + LANES`, one whole vector, which covers the padding `n..padded(n)` (the
+/// `computed` arrays are written over the padded range before they are read). The arrays
+/// never shrink, so that stencils of varying size write no new entries.
+#[inline(always)]
 fn pad_each<const P: usize, const C: usize>(
     padding: [(&mut Vec<f64>, f64); P],
     computed: [&mut Vec<f64>; C],
     n: usize,
 ) {
+    let room = n + LANES;
     let grow = |v: &mut Vec<f64>| {
-        if v.len() < padded(n) {
-            v.resize(padded(n), 0.0);
+        if v.len() < room {
+            v.resize(room, 0.0);
         }
     };
     for (v, pad) in padding {
         grow(v);
-        v[n..padded(n)].fill(pad);
+        v[n..room].copy_from_slice(&[pad; LANES]);
     }
     computed.into_iter().for_each(grow);
 }
@@ -219,6 +223,7 @@ struct Members {
 
 impl Members {
     /// Makes room for `n` members and pads them to [`padded`]`(n)`.
+    #[inline(always)]
     fn resize(&mut self, n: usize) {
         self.n = n;
         let padding = [

@@ -11,6 +11,9 @@ use rayon::prelude::*;
 const CONSTRAINT_GOAL: f64 = 1e-14;
 /// At most this many Newton-like steps per projection.
 const MAX_PROJECTION_STEPS: usize = 100;
+/// The local step and the gather take particles in runs of this many, each run with one
+/// borrow of the thread's buffers.
+pub(crate) const CHUNK: usize = 64;
 /// A stencil's members are kept in arrays padded to a multiple of this many entries, so
 /// that every loop over them runs in whole vectors of four lanes with no remainder.
 const LANES: usize = 4;
@@ -285,7 +288,7 @@ fn ordered_dot(a: &[f64], b: &[f64]) -> f64 {
     (partial[0] + partial[1]) + (partial[2] + partial[3]) + tail
 }
 
-/// Per-thread buffers of one gather ([`DensityConstraint::gathered_correction`]): the
+/// Per-thread buffers of one gather ([`DensityConstraint::gathered_corrections`]): the
 /// neighbours whose projection moved the particle, their λ (m²), offsets x_j − x_i (m) by
 /// component, and λ times the kernel's gradient coefficient (1/m³).
 #[derive(Default)]
@@ -671,21 +674,24 @@ impl DensityConstraint {
         projections.resize(x.len(), Projection::default());
         c.lambdas.resize(x.len(), 0.0);
         projections
-            .par_iter_mut()
-            .zip(c.lambdas.par_iter_mut())
+            .par_chunks_mut(CHUNK)
+            .zip(c.lambdas.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(i, (out, lambda))| {
+            .for_each(|(chunk, (outs, lambdas))| {
                 SCRATCH.with_borrow_mut(|scratch| {
                     // Corrections written here are dropped; the buffer only grows.
                     let mut dp = std::mem::take(&mut scratch.dp);
-                    let members = nb.fluid.count(i) + 1;
-                    if dp.len() < members {
-                        dp.resize(members, Vec3::zeros());
+                    for (k, (out, lambda)) in outs.iter_mut().zip(lambdas).enumerate() {
+                        let i = chunk * CHUNK + k;
+                        let members = nb.fluid.count(i) + 1;
+                        if dp.len() < members {
+                            dp.resize(members, Vec3::zeros());
+                        }
+                        self.project_one(i, x, nb, &mut dp[..members], out, scratch);
+                        *lambda = if out.materialized { 0.0 } else { out.lambda };
                     }
-                    self.project_one(i, x, nb, &mut dp[..members], out, scratch);
                     scratch.dp = dp;
                 });
-                *lambda = if out.materialized { 0.0 } else { out.lambda };
             });
 
         // The flags were set only if the last local step kept a segment (rarely); only then
@@ -726,22 +732,27 @@ impl DensityConstraint {
     }
 
     /// Σ_{i: j∈N̄_j} (P_{i,j} − x_j): the sum of all corrections the local step made to
-    /// particle j's position (m), gathered from its own and its neighbours' projections.
+    /// particle j's position (m), gathered from its own and its neighbours' projections,
+    /// for every particle j of `first..first + out.len()`, into `out[j − first]`.
     #[inline]
-    pub fn gathered_correction(
+    pub fn gathered_corrections(
         &self,
-        j: usize,
+        first: usize,
         x: &[Vec3],
         nb: &Neighborhood,
         projections: &[Projection],
         corrections: &Corrections,
-    ) -> Vec3 {
-        GATHER
-            .with_borrow_mut(|gather| self.gather_into(j, x, nb, projections, corrections, gather))
+        out: &mut [Vec3],
+    ) {
+        GATHER.with_borrow_mut(|gather| {
+            for (j, sum) in (first..).zip(out) {
+                *sum = self.gather_into(j, x, nb, projections, corrections, gather);
+            }
+        })
     }
 
     crate::simd::avx2_dispatch! {
-        /// [`Self::gathered_correction`] with the thread's buffers; the AVX2 build evaluates
+        /// [`Self::gathered_corrections`] with the thread's buffers; the AVX2 build evaluates
         /// the gradients four lanes wide, bitwise alike (tested).
         fn gather_into / gather_into_avx2(
             &self,
@@ -754,7 +765,7 @@ impl DensityConstraint {
         ) -> Vec3 where !self.portable => gathered_correction_portable
     }
 
-    /// The body of [`Self::gathered_correction`]. A first pass lists, without branches, the
+    /// The body of [`Self::gathered_corrections`]. A first pass lists, without branches, the
     /// neighbours i whose single-step projection moved j (λ_i ≠ 0; about a quarter of them
     /// in a flow, in no predictable order); a second evaluates their λ_i∇W(x_j − x_i) by
     /// component, four at a time. Kept segments are read apart (rare).

@@ -2,7 +2,7 @@
 //! global solves (with Chebyshev extrapolation) until the displacement rule stops, update
 //! velocities, apply XSPH, and choose the next step size by the CFL rule (§8).
 
-use crate::constraint::{Corrections, Neighborhood, Projection};
+use crate::constraint::{CHUNK, Corrections, Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists};
 use crate::params::SolverKind;
 use crate::solver::DiagonalSystem;
@@ -227,13 +227,26 @@ impl World {
                 let t_local = t.elapsed().as_secs_f64();
                 let (projections, corrections) = (&b.projections, &b.corrections);
                 let current = &b.current;
-                b.rhs.par_iter_mut().enumerate().for_each(|(j, rhs)| {
-                    // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction.
-                    let sum =
-                        constraint.gathered_correction(j, current, &nb, projections, corrections);
-                    let members = constraint.membership(lists, j);
-                    *rhs = b.predicted[j] * mass + (current[j] * members + sum) * dt2k;
-                });
+                let predicted = &b.predicted;
+                b.rhs
+                    .par_chunks_mut(CHUNK)
+                    .enumerate()
+                    .for_each(|(chunk, rhs)| {
+                        // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction.
+                        let first = chunk * CHUNK;
+                        constraint.gathered_corrections(
+                            first,
+                            current,
+                            &nb,
+                            projections,
+                            corrections,
+                            rhs,
+                        );
+                        for (j, rhs) in (first..).zip(rhs) {
+                            let members = constraint.membership(lists, j);
+                            *rhs = predicted[j] * mass + (current[j] * members + *rhs) * dt2k;
+                        }
+                    });
                 b.next.copy_from_slice(&b.current);
                 inner += solver.solve(&b.system, &b.rhs, &mut b.next);
                 if accelerate {

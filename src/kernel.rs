@@ -123,13 +123,8 @@ mod tests {
         let h = 0.1;
         let kernel = CubicKernel::new(h);
         let m = kernel.curvature_bound();
-        let mut seed = 12345u64;
-        let mut uniform = || {
-            seed = seed
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-        };
+        let mut rng = crate::random::SplitMix64(12345);
+        let mut uniform = || rng.next_f64() * 2.0 - 1.0;
         let mut worst: f64 = 0.0;
         for _ in 0..200_000 {
             let r = Vec3::new(uniform(), uniform(), uniform()) * (1.1 * h);

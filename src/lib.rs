@@ -25,6 +25,7 @@ pub mod kernel;
 pub mod neighbors;
 pub mod params;
 pub mod plot;
+mod random;
 pub mod reduce;
 pub mod scene;
 mod simd;

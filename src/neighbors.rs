@@ -436,13 +436,8 @@ mod tests {
     use super::*;
 
     fn random_points(n: usize, seed: u64, extent: f64) -> Vec<Vec3> {
-        let mut state = seed;
-        let mut next = move || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
+        let mut rng = crate::random::SplitMix64(seed);
+        let mut next = move || rng.next_f64();
         (0..n)
             .map(|_| Vec3::new(next(), next(), next()) * extent)
             .collect()

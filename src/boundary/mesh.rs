@@ -3,6 +3,7 @@
 //! surfaces", as used by SPlisHSPlasH) followed by a gap-filling pass, so that obstacles of
 //! any shape become boundary particles spaced about one particle radius apart.
 
+use crate::random::{SplitMix64, mix64};
 use crate::{Error, Vec3};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
@@ -314,29 +315,6 @@ fn random_candidates(mesh: &TriangleMesh, min_distance: f64) -> Vec<(u64, Vec3)>
         out.push((grid.key(&grid.cell(&p)), p));
     }
     out
-}
-
-/// SplitMix64 (Steele, Lea and Flood 2014): a small, fast, well-mixed generator, enough for
-/// sampling candidates and reproducible everywhere.
-struct SplitMix64(u64);
-
-impl SplitMix64 {
-    fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        mix64(self.0)
-    }
-
-    /// Uniform in [0, 1).
-    fn next_f64(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 * (1.0 / (1u64 << 53) as f64)
-    }
-}
-
-/// The SplitMix64 finaliser: a bijective mix of all 64 bits.
-fn mix64(mut z: u64) -> u64 {
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-    z ^ (z >> 31)
 }
 
 /// Hashes a `u64` cell key with [`mix64`].

@@ -431,9 +431,9 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
         // step gathers it.
         let c = &world.constraint;
-        let mut forces = vec![Vec3::zeros(); x.len()];
-        c.gathered_corrections(0, &x, &nb, &projections, &corrections, &mut forces);
-        let force_sum: f64 = forces.iter().map(|f| f.y).sum();
+        let mut gathered = vec![Vec3::zeros(); x.len()];
+        c.gathered_corrections(0, &x, &nb, &projections, &corrections, &mut gathered);
+        let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
         let support = force_sum * params.stiffness / x.len().max(1) as f64;
         let pressures = x
             .iter()

@@ -582,7 +582,7 @@ impl DensityConstraint {
 
     /// The XSPH-filtered velocity of fluid particle i (m/s), ALGORITHM.md §1.3:
     /// v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij, with positions `x` (m), velocities `v` (m/s)
-    /// and densities `rho` (kg/m³) of the fluid.
+    /// and volumes m/ρ_j (m³) of the fluid (one division per particle, not per pair).
     pub fn xsph_velocity(
         &self,
         c: f64,
@@ -612,7 +612,7 @@ impl DensityConstraint {
         &self,
         c: f64,
         i: usize,
-        (x, v, rho): (&[Vec3], &[Vec3], &[f64]),
+        (x, v, volumes): (&[Vec3], &[Vec3], &[f64]),
         nb: &Neighborhood,
         members: &mut Members,
     ) -> Vec3 {
@@ -625,7 +625,7 @@ impl DensityConstraint {
             .zip(&members.values)
             .map(|(&j, w)| {
                 let j = j as usize;
-                (v[j] - vi) * (self.mass / rho[j] * w)
+                (v[j] - vi) * (volumes[j] * w)
             })
             .sum();
         vi + sum * c
@@ -1102,7 +1102,8 @@ mod tests {
                         })
                         .sum::<Vec3>()
                         * 0.1;
-                let xsph = constraint.xsph_velocity(0.1, i, (x, &v, &rho), &nb);
+                let volumes: Vec<f64> = rho.iter().map(|r| constraint.mass / r).collect();
+                let xsph = constraint.xsph_velocity(0.1, i, (x, &v, &volumes), &nb);
                 assert!((xsph - xsph_direct).norm() <= 1e-12, "XSPH v_{i}");
             }
             assert!(remainders.iter().all(|&n| n > 0), "{remainders:?}");

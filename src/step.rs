@@ -33,6 +33,8 @@ pub(crate) struct StepBuffers {
     /// The projection weight w_j of every fluid particle.
     weights: Vec<f64>,
     system: DiagonalSystem,
+    /// The volume m/ρ_j of every fluid particle after the step, for XSPH (m³).
+    volumes: Vec<f64>,
     scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
     /// δ_k of every outer iteration of the last step (m).
@@ -285,7 +287,8 @@ impl World {
             // 6. Densities at the new positions (step's neighbour lists), 7. XSPH.
             constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
             if params.viscosity > 0.0 {
-                xsph(params.viscosity, constraint, &nb, fluid, &mut b.scratch);
+                let buffers = (&mut b.volumes, &mut b.scratch);
+                xsph(params.viscosity, constraint, &nb, fluid, buffers);
             }
             let rest = constraint.rest_density;
             let errors = |rho: &f64| (rho / rest - 1.0).max(0.0);
@@ -343,19 +346,19 @@ fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
     reduce::max_over(a.len(), |i| (a[i] - b[i]).norm())
 }
 
-/// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (ALGORITHM.md §1.3).
+/// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (ALGORITHM.md §1.3), with the
+/// buffers for the volumes m/ρ_j and the new velocities.
 fn xsph(
     c: f64,
     constraint: &crate::constraint::DensityConstraint,
     nb: &Neighborhood,
     fluid: &mut crate::world::Fluid,
-    scratch: &mut Vec<Vec3>,
+    (volumes, scratch): (&mut Vec<f64>, &mut Vec<Vec3>),
 ) {
-    let state = (
-        &fluid.positions[..],
-        &fluid.velocities[..],
-        &fluid.densities[..],
-    );
+    let mass = constraint.mass;
+    volumes.clear();
+    volumes.par_extend(fluid.densities.par_iter().map(|rho| mass / rho));
+    let state = (&fluid.positions[..], &fluid.velocities[..], &volumes[..]);
     scratch.resize(fluid.velocities.len(), Vec3::zeros());
     scratch
         .par_iter_mut()

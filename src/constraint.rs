@@ -1063,6 +1063,7 @@ mod tests {
                 .collect();
             let mut rho = Vec::new();
             constraint.densities(x, &nb, &mut rho);
+            let volumes: Vec<f64> = rho.iter().map(|r| constraint.mass / r).collect();
             let mut remainders = [0usize; 4];
             let mut scratch = Scratch::default();
             for i in 0..x.len() {
@@ -1102,7 +1103,6 @@ mod tests {
                         })
                         .sum::<Vec3>()
                         * 0.1;
-                let volumes: Vec<f64> = rho.iter().map(|r| constraint.mass / r).collect();
                 let xsph = constraint.xsph_velocity(0.1, i, (x, &v, &volumes), &nb);
                 assert!((xsph - xsph_direct).norm() <= 1e-12, "XSPH v_{i}");
             }

@@ -27,8 +27,8 @@ pub struct StepStats {
     pub inner_iterations: usize,
     /// The outer loop ended at its iteration limit instead of the displacement rule.
     pub hit_max_iterations: bool,
-    /// Chebyshev's ρ_c in this step (the online estimate with `auto_rho`); 0 when the step did
-    /// not extrapolate (other solvers, probe steps of the online estimate).
+    /// Chebyshev's ρ_c in this step (the online estimate with `auto_rho`); 0 for the other
+    /// solvers.
     pub rho: f64,
     /// Largest particle displacement in the last outer iteration (m).
     pub last_displacement: f64,

@@ -219,8 +219,7 @@ impl World {
                 weights: &b.weights,
             };
             chebyshev.reset();
-            let chebyshev_step = params.solver == SolverKind::Chebyshev;
-            let accelerate = chebyshev_step && chebyshev.accelerates();
+            let accelerate = params.solver == SolverKind::Chebyshev;
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
             b.displacements.clear();
             while outer < params.max_outer_iterations {
@@ -272,7 +271,7 @@ impl World {
             }
 
             let rho = if accelerate { chebyshev.rho() } else { 0.0 };
-            if chebyshev_step {
+            if accelerate {
                 chebyshev.finish_step(&b.displacements);
             }
             // 5. Velocity update v = (x^{n+1} − x^n)/Δt, then the new positions.

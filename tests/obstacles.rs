@@ -57,7 +57,7 @@ fn water_poured_over_a_thin_walled_cup_does_not_leak_through_its_walls() {
     });
 }
 
-/// So does the plain iteration (which `--rho auto` also runs in its probe steps).
+/// So does the plain iteration.
 #[test]
 fn plain_iteration_does_not_leak_through_thin_walls_either() {
     pour_and_check(Params {

@@ -1,33 +1,31 @@
 //! Chebyshev semi-iterative acceleration of the outer local/global iteration
 //! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]), with a fixed ρ_c or one estimated online from
-//! probes of the plain iteration ([`ChebyshevParams::auto_rho`]; README, "Choosing ρ").
+//! the accelerated steps themselves ([`ChebyshevParams::auto_rho`]; README, "Choosing ρ").
 
 use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-/// With `auto_rho`, every this many steps one step runs the plain iteration (a probe) to
-/// measure its contraction.
-pub const AUTO_PROBE_INTERVAL: u64 = 40;
-/// A probe needs at least this many outer iterations to give an estimate.
-pub const AUTO_MIN_PROBE_ITERATIONS: usize = 20;
-/// ρ_c = κ·ρ̂ with ρ̂ the smoothed contraction of the probes (README, "Choosing ρ").
-pub const AUTO_KAPPA: f64 = 0.9;
-/// Weight of a new probe's contraction in the exponential moving average ρ̂.
+/// A step needs at least this many outer iterations to give an estimate of the plain
+/// iteration's contraction.
+pub const AUTO_MIN_ITERATIONS: usize = 5;
+/// ρ_c = κ·μ̂ with μ̂ the smoothed estimate of the plain iteration's contraction. κ < 1 is
+/// what lets ρ_c come down again: an estimate is never below the ρ_c it was measured with
+/// ([`plain_contraction`]), so only the factor κ pulls an over-estimated ρ_c back.
+pub const AUTO_KAPPA: f64 = 0.97;
+/// Weight of a new step's estimate in the exponential moving average μ̂.
 pub const AUTO_SMOOTHING: f64 = 0.5;
 /// Range that the online ρ_c is clamped to.
-pub const AUTO_RHO_RANGE: (f64, f64) = (0.5, 0.95);
+pub const AUTO_RHO_RANGE: (f64, f64) = (0.5, 0.925);
 
 /// The online ρ_c estimate carried from step to step (saved in checkpoints).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct OnlineRho {
     /// ρ_c of the next step.
     pub rho: f64,
-    /// Smoothed contraction ρ̂ of the probes so far.
+    /// Smoothed estimate μ̂ of the plain iteration's contraction, once measured.
     pub contraction: Option<f64>,
-    /// Steps since the last probe.
-    pub since_probe: u64,
 }
 
 /// The ω recurrence of one time step, and the online ρ_c estimate carried across steps.
@@ -37,39 +35,24 @@ pub struct Chebyshev {
     omega: f64,
     /// ρ_c of the current step.
     rho: f64,
-    /// Smoothed plain-iteration contraction ρ̂ (online mode), once measured.
+    /// Smoothed estimate μ̂ of the plain iteration's contraction (online mode), once measured.
     contraction: Option<f64>,
-    /// Steps since the last probe.
-    since_probe: u64,
-    /// The current step is a probe: plain iteration, no extrapolation.
-    probing: bool,
 }
 
 impl Chebyshev {
     /// A recurrence with the given settings, ready for the first outer iteration.
     pub fn new(params: ChebyshevParams) -> Self {
-        let mut c = Self {
+        Self {
             params,
             omega: 1.0,
             rho: params.rho,
             contraction: None,
-            since_probe: AUTO_PROBE_INTERVAL,
-            probing: false,
-        };
-        c.reset();
-        c
+        }
     }
 
-    /// Restarts the recurrence at the start of every time step and, with `auto_rho`, decides
-    /// whether this step is a probe: the first step, then every [`AUTO_PROBE_INTERVAL`] steps.
+    /// Restarts the recurrence at the start of every time step.
     pub fn reset(&mut self) {
         self.omega = 1.0;
-        self.probing = self.params.auto_rho && self.since_probe >= AUTO_PROBE_INTERVAL;
-    }
-
-    /// True when the current step extrapolates (false during a probe).
-    pub fn accelerates(&self) -> bool {
-        !self.probing
     }
 
     /// The online estimate's state, to be saved with the world.
@@ -77,7 +60,6 @@ impl Chebyshev {
         OnlineRho {
             rho: self.rho,
             contraction: self.contraction,
-            since_probe: self.since_probe,
         }
     }
 
@@ -85,7 +67,6 @@ impl Chebyshev {
     pub fn set_online(&mut self, state: OnlineRho) {
         self.rho = state.rho;
         self.contraction = state.contraction;
-        self.since_probe = state.since_probe;
         self.reset();
     }
 
@@ -113,27 +94,23 @@ impl Chebyshev {
         self.omega
     }
 
-    /// Online mode only: learns from the displacements δ_0..δ_K of the step just finished.
-    /// After a probe with at least [`AUTO_MIN_PROBE_ITERATIONS`] iterations, the contraction
-    /// (δ_K/δ_h)^(1/(K−h)) over the last half (h = ⌊(K+1)/2⌋) enters ρ̂ ← (1 − a)ρ̂ + a·rate
-    /// and ρ_c = clamp(κ·ρ̂); a shorter probe leaves ρ_c as it was (the starting `rho` until
-    /// the first estimate).
+    /// Online mode only: learns from the displacements δ_0..δ_K of the step just finished,
+    /// which extrapolated with the current ρ_c. If the step took at least
+    /// [`AUTO_MIN_ITERATIONS`] iterations, their contraction over the last half
+    /// ([`late_contraction`]) gives an estimate of the plain iteration's contraction
+    /// ([`plain_contraction`]), which enters μ̂ ← (1 − a)μ̂ + a·estimate; then
+    /// ρ_c = clamp(κ·μ̂). Until the first estimate ρ_c is the scene's `rho`.
     pub fn finish_step(&mut self, displacements: &[f64]) {
         if !self.params.auto_rho {
             return;
         }
-        if !self.probing {
-            self.since_probe += 1;
-            return;
-        }
-        // Whether or not it measured something, the next probe comes an interval later.
-        self.since_probe = 0;
-        let Some(rate) = late_contraction(displacements) else {
+        let Some(rate) = late_contraction(displacements, AUTO_MIN_ITERATIONS) else {
             return;
         };
+        let estimate = plain_contraction(rate, self.rho);
         let smoothed = match self.contraction {
-            Some(c) => c + AUTO_SMOOTHING * (rate - c),
-            None => rate,
+            Some(c) => c + AUTO_SMOOTHING * (estimate - c),
+            None => estimate,
         };
         self.contraction = Some(smoothed);
         let (lo, hi) = AUTO_RHO_RANGE;
@@ -162,15 +139,32 @@ impl Chebyshev {
 }
 
 /// Geometric-mean ratio of successive displacements over the last half of `displacements`,
-/// or `None` when there are fewer than [`AUTO_MIN_PROBE_ITERATIONS`] or they are not positive.
-fn late_contraction(displacements: &[f64]) -> Option<f64> {
+/// (δ_K/δ_h)^(1/(K−h)) with h = ⌊(K+1)/2⌋, at most 1; `None` when there are fewer than
+/// `at_least` or they are not positive.
+fn late_contraction(displacements: &[f64], at_least: usize) -> Option<f64> {
     let n = displacements.len();
-    if n < AUTO_MIN_PROBE_ITERATIONS {
+    if n < at_least.max(3) {
         return None;
     }
     let (first, last) = (displacements[n / 2], displacements[n - 1]);
     let rate = (last / first).powf(1.0 / (n - 1 - n / 2) as f64);
     (first > 0.0 && last > 0.0 && rate.is_finite()).then(|| rate.min(1.0))
+}
+
+/// The contraction μ of the plain iteration that makes Chebyshev's iteration with parameter
+/// `rho_c` (< μ) contract at `rate` per iteration, in the linear model of ALGORITHM.md §5.4,
+/// as in the adaptive Chebyshev procedures of Hageman and Young (Applied Iterative Methods,
+/// 1981). Its slowest mode contracts at r = (μ + √(μ² − ρ_c²))/(1 + √(1 − ρ_c²)); with
+/// a = r·(1 + √(1 − ρ_c²)) that inverts to μ = (a² + ρ_c²)/(2a). A rate at or below what
+/// ρ_c ≥ μ would give (a ≤ ρ_c) says only that μ ≤ ρ_c, and returns ρ_c. With ρ_c = 0
+/// (no extrapolation) it returns `rate` itself (up to rounding). Never below ρ_c.
+fn plain_contraction(rate: f64, rho_c: f64) -> f64 {
+    let a = rate * (1.0 + (1.0 - rho_c * rho_c).sqrt());
+    if a > rho_c {
+        (a * a + rho_c * rho_c) / (2.0 * a)
+    } else {
+        rho_c
+    }
 }
 
 #[cfg(test)]
@@ -231,47 +225,91 @@ mod tests {
         assert!(accelerated < plain / 3, "{accelerated} vs {plain}");
     }
 
+    /// The displacements max_c |X^(k+1) − X^(k)| of `iterations` accelerated iterations of
+    /// x ← G x + c from x = 0, with the weights and ρ_c of `cheb`.
+    fn displacements(cheb: &mut Chebyshev, g: Vec3, c: Vec3, iterations: usize) -> Vec<f64> {
+        cheb.reset();
+        let (mut prev, mut cur) = (vec![Vec3::zeros()], vec![Vec3::zeros()]);
+        (0..iterations)
+            .map(|k| {
+                let mut next = vec![g.component_mul(&cur[0]) + c];
+                let w = cheb.next_weight(k);
+                cheb.extrapolate(w, &mut next, &cur, &prev);
+                let delta = (next[0] - cur[0]).abs().max();
+                prev = std::mem::replace(&mut cur, next);
+                delta
+            })
+            .collect()
+    }
+
     #[test]
-    fn online_rho_comes_from_probes_of_the_plain_iteration() {
-        let mut c = Chebyshev::new(ChebyshevParams {
-            auto_rho: true,
-            ..params(0.85, 1, Omega2Rule::SeedLiteral)
-        });
-        // Probe every AUTO_PROBE_INTERVAL steps, starting with the first.
-        let next_probe = |c: &mut Chebyshev| {
-            for _ in 0..AUTO_PROBE_INTERVAL {
-                c.reset();
-                assert!(c.accelerates());
-                c.finish_step(&[1.0, 0.1]);
+    fn plain_contraction_inverts_the_chebyshev_rate() {
+        for mu in [0.7f64, 0.9, 0.97] {
+            for rho_c in [0.0f64, 0.5, 0.69] {
+                let s = (1.0 - rho_c * rho_c).sqrt();
+                let rate = (mu + (mu * mu - rho_c * rho_c).sqrt()) / (1.0 + s);
+                let estimate = plain_contraction(rate, rho_c);
+                assert!((estimate - mu).abs() < 1e-12, "{mu} {rho_c}: {estimate}");
             }
-            c.reset();
-            assert!(!c.accelerates());
+        }
+        // Over-estimated: every mode contracts at √(ω∞ − 1) = ρ_c/(1 + √(1 − ρ_c²)) or
+        // faster, which says only that μ ≤ ρ_c.
+        let ideal = 0.9 / (1.0 + (1.0 - 0.81f64).sqrt());
+        assert_eq!(plain_contraction(ideal, 0.9), 0.9);
+        assert_eq!(plain_contraction(0.3, 0.9), 0.9);
+        assert!((plain_contraction(0.8, 0.0) - 0.8).abs() < 1e-15);
+    }
+
+    #[test]
+    fn online_rho_finds_the_contraction_of_a_linear_iteration() {
+        let online = |rho| {
+            Chebyshev::new(ChebyshevParams {
+                auto_rho: true,
+                ..params(rho, 1, Omega2Rule::SeedLiteral)
+            })
         };
-        assert!(!c.accelerates());
+        // Plain iteration contracts at 0.95 (the other modes faster, one alternating).
+        let (g, c) = (Vec3::new(0.95, 0.3, -0.5), Vec3::new(1.0, 2.0, 3.0));
+        let mut cheb = online(0.6);
         // Too short to measure: the starting ρ_c stays.
-        c.finish_step(&[1.0, 0.5, 0.2]);
-        assert_eq!(c.rho(), 0.85);
-        next_probe(&mut c);
-        // Twenty iterations contracting at 0.9.
-        let probe: Vec<f64> = (0..20).map(|k| 0.9f64.powi(k)).collect();
-        c.finish_step(&probe);
-        let first = AUTO_KAPPA * 0.9;
-        assert!((c.rho() - first).abs() < 1e-12, "{}", c.rho());
-        c.reset();
-        assert!(c.accelerates());
-        assert_eq!(c.next_weight(0), 1.0);
-        assert_eq!(c.next_weight(1), 4.0 / (4.0 - first * first));
-        // The next probe is smoothed in.
-        next_probe(&mut c);
-        let probe: Vec<f64> = (0..22).map(|k| 0.99f64.powi(k)).collect();
-        c.finish_step(&probe);
-        let smoothed = 0.9 + AUTO_SMOOTHING * (0.99 - 0.9);
-        let expected = (AUTO_KAPPA * smoothed).clamp(AUTO_RHO_RANGE.0, AUTO_RHO_RANGE.1);
-        assert!((c.rho() - expected).abs() < 1e-12);
-        // A fixed ρ_c never probes.
+        let short = displacements(&mut cheb, g, c, AUTO_MIN_ITERATIONS - 1);
+        cheb.finish_step(&short);
+        assert_eq!((cheb.rho(), cheb.online().contraction), (0.6, None));
+        let first = displacements(&mut cheb, g, c, 40);
+        cheb.finish_step(&first);
+        // Measured while extrapolating with ρ_c = 0.6, the step still sees μ ≈ 0.95.
+        let estimate = cheb.online().contraction.unwrap();
+        assert!((estimate - 0.95).abs() < 0.01, "{estimate}");
+        assert_eq!(cheb.rho(), AUTO_KAPPA * estimate);
+        for _ in 0..10 {
+            let d = displacements(&mut cheb, g, c, 40);
+            cheb.finish_step(&d);
+        }
+        let settled = cheb.rho();
+        assert!((settled - AUTO_KAPPA * 0.95).abs() < 0.005, "{settled}");
+        // The settled ρ_c needs well under half the iterations of the starting one to
+        // bring the displacement below 10⁻⁸ (123 against 287; plain iteration 360).
+        let below = |d: Vec<f64>| d.iter().position(|&d| d < 1e-8).unwrap();
+        let accelerated = below(displacements(&mut cheb, g, c, 1000));
+        let mut start = Chebyshev::new(params(0.6, 1, Omega2Rule::SeedLiteral));
+        let from_start = below(displacements(&mut start, g, c, 1000));
+        assert!(
+            accelerated * 2 < from_start,
+            "{accelerated} vs {from_start}"
+        );
+
+        // An over-estimated ρ_c (plain contraction 0.6) comes down, and not below it by much.
+        let g = Vec3::new(0.6, 0.3, -0.5);
+        let mut cheb = online(0.92);
+        for _ in 0..40 {
+            let d = displacements(&mut cheb, g, c, 30);
+            cheb.finish_step(&d);
+        }
+        assert!((0.55..0.65).contains(&cheb.rho()), "{}", cheb.rho());
+
+        // A fixed ρ_c never changes.
         let mut fixed = Chebyshev::new(params(0.85, 1, Omega2Rule::SeedLiteral));
-        assert!(fixed.accelerates());
-        fixed.finish_step(&probe);
+        fixed.finish_step(&first);
         assert_eq!(fixed.rho(), 0.85);
     }
 }

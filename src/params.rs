@@ -170,9 +170,10 @@ pub struct ChebyshevParams {
     pub omega2_rule: Omega2Rule,
     /// Under-relaxation γ in (0, 1].
     pub gamma: f64,
-    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every 40th step runs
-    /// the plain iteration and measures its contraction ρ̂, and ρ_c = 0.9·ρ̂ (smoothed, clamped
-    /// to [0.5, 0.95]); `rho` is only the value used until the first estimate. On by default
+    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every step of five
+    /// or more outer iterations estimates the plain iteration's contraction μ from how fast
+    /// its own extrapolated iterates contracted, and ρ_c = 0.97·μ (smoothed, clamped to
+    /// [0.5, 0.925]); `rho` is only the value used until the first estimate. On by default
     /// (it met its goal on every built-in scene); setting a fixed ρ (scene `"rho": 0.9`,
     /// `--rho 0.9`) turns it off.
     pub auto_rho: bool,

@@ -104,7 +104,7 @@ impl Chebyshev {
         if !self.params.auto_rho {
             return;
         }
-        let Some(rate) = late_contraction(displacements, AUTO_MIN_ITERATIONS) else {
+        let Some(rate) = late_contraction(displacements) else {
             return;
         };
         let estimate = plain_contraction(rate, self.rho);
@@ -140,10 +140,12 @@ impl Chebyshev {
 
 /// Geometric-mean ratio of successive displacements over the last half of `displacements`,
 /// (δ_K/δ_h)^(1/(K−h)) with h = ⌊(K+1)/2⌋, at most 1; `None` when there are fewer than
-/// `at_least` or they are not positive.
-fn late_contraction(displacements: &[f64], at_least: usize) -> Option<f64> {
+/// [`AUTO_MIN_ITERATIONS`] or they are not positive.
+fn late_contraction(displacements: &[f64]) -> Option<f64> {
+    // Three displacements at least, so that the last half spans one ratio or more.
+    const _: () = assert!(AUTO_MIN_ITERATIONS >= 3);
     let n = displacements.len();
-    if n < at_least.max(3) {
+    if n < AUTO_MIN_ITERATIONS {
         return None;
     }
     let (first, last) = (displacements[n / 2], displacements[n - 1]);
@@ -207,17 +209,10 @@ mod tests {
         let fixed = c.component_div(&(Vec3::repeat(1.0) - g));
         let iterations = |rho: f64| {
             let mut cheb = Chebyshev::new(params(rho, 1, Omega2Rule::Chebyshev));
-            let (mut prev, mut cur) = (vec![Vec3::zeros()], vec![Vec3::zeros()]);
-            for k in 0..1000 {
-                let mut next = vec![g.component_mul(&cur[0]) + c];
-                let w = cheb.next_weight(k);
-                cheb.extrapolate(w, &mut next, &cur, &prev);
-                prev = std::mem::replace(&mut cur, next);
-                if (cur[0] - fixed).norm() < 1e-10 {
-                    return k;
-                }
-            }
-            1000
+            iterates(&mut cheb, g, c, 1000)
+                .iter()
+                .position(|x| (x - fixed).norm() < 1e-10)
+                .unwrap_or(1000)
         };
         let plain = iterations(0.0);
         let accelerated = iterations(0.9);
@@ -225,20 +220,29 @@ mod tests {
         assert!(accelerated < plain / 3, "{accelerated} vs {plain}");
     }
 
-    /// The displacements max_c |X^(k+1) − X^(k)| of `iterations` accelerated iterations of
-    /// x ← G x + c from x = 0, with the weights and ρ_c of `cheb`.
-    fn displacements(cheb: &mut Chebyshev, g: Vec3, c: Vec3, iterations: usize) -> Vec<f64> {
+    /// X^(1)..X^(n) of `n` accelerated iterations of x ← G x + c from X^(0) = 0, with the
+    /// weights and ρ_c of `cheb`.
+    fn iterates(cheb: &mut Chebyshev, g: Vec3, c: Vec3, n: usize) -> Vec<Vec3> {
         cheb.reset();
         let (mut prev, mut cur) = (vec![Vec3::zeros()], vec![Vec3::zeros()]);
-        (0..iterations)
+        (0..n)
             .map(|k| {
                 let mut next = vec![g.component_mul(&cur[0]) + c];
                 let w = cheb.next_weight(k);
                 cheb.extrapolate(w, &mut next, &cur, &prev);
-                let delta = (next[0] - cur[0]).abs().max();
                 prev = std::mem::replace(&mut cur, next);
-                delta
+                cur[0]
             })
+            .collect()
+    }
+
+    /// The displacements max_c |X^(k+1) − X^(k)| of [`iterates`].
+    fn displacements(cheb: &mut Chebyshev, g: Vec3, c: Vec3, n: usize) -> Vec<f64> {
+        let x = iterates(cheb, g, c, n);
+        let start = std::iter::once(Vec3::zeros()).chain(x.iter().copied());
+        x.iter()
+            .zip(start)
+            .map(|(next, cur)| (next - cur).abs().max())
             .collect()
     }
 

@@ -32,17 +32,20 @@ pub fn max<T: Sync>(items: &[T], f: impl Fn(&T) -> f64 + Sync + Send) -> f64 {
 
 /// max f(i) for i in 0..n (−∞ for none); NaN values propagate as NaN.
 pub fn max_over(n: usize, f: impl Fn(usize) -> f64 + Sync + Send) -> f64 {
-    let nan_aware = |a: f64, b: f64| {
-        if a.is_nan() || b.is_nan() {
-            f64::NAN
-        } else {
-            a.max(b)
-        }
-    };
     (0..n)
         .into_par_iter()
         .map(f)
-        .reduce(|| f64::NEG_INFINITY, nan_aware)
+        .reduce(|| f64::NEG_INFINITY, nan_max)
+}
+
+/// The larger of `a` and `b`, NaN if either is NaN (the combining step of [`max_over`]).
+#[inline]
+pub fn nan_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() {
+        f64::NAN
+    } else {
+        a.max(b)
+    }
 }
 
 #[cfg(test)]

@@ -5,7 +5,7 @@
 use crate::constraint::{CHUNK, Corrections, Neighborhood, Projection};
 use crate::neighbors::{CellTable, NeighborLists};
 use crate::params::SolverKind;
-use crate::solver::DiagonalSystem;
+use crate::solver::{Chebyshev, DiagonalSystem};
 use crate::stats::{StepStats, StepTimings};
 use crate::{Error, Vec3, World, reduce};
 use rayon::prelude::*;
@@ -220,6 +220,7 @@ impl World {
             };
             chebyshev.reset();
             let accelerate = params.solver == SolverKind::Chebyshev;
+            let single_sweep = solver.single_diagonal_sweep();
             let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
             b.displacements.clear();
             while outer < params.max_outer_iterations {
@@ -227,34 +228,61 @@ impl World {
                 constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
                 let t_local = t.elapsed().as_secs_f64();
                 let (projections, corrections) = (&b.projections, &b.corrections);
-                let current = &b.current;
-                let predicted = &b.predicted;
-                b.rhs
-                    .par_chunks_mut(CHUNK)
-                    .enumerate()
-                    .for_each(|(chunk, rhs)| {
-                        // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction.
-                        let first = chunk * CHUNK;
-                        constraint.gathered_corrections(
-                            first,
-                            current,
-                            &nb,
-                            projections,
-                            corrections,
-                            rhs,
-                        );
-                        for (j, rhs) in (first..).zip(rhs) {
-                            let members = constraint.membership(lists, j);
-                            *rhs = predicted[j] * mass + (current[j] * members + *rhs) * dt2k;
-                        }
-                    });
-                b.next.copy_from_slice(&b.current);
-                inner += solver.solve(&b.system, &b.rhs, &mut b.next);
-                if accelerate {
-                    let omega = chebyshev.next_weight(outer);
-                    chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
+                let (current, predicted) = (&b.current, &b.predicted);
+                // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
+                // for the particles of chunk `chunk`.
+                let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {
+                    let first = chunk * CHUNK;
+                    constraint.gathered_corrections(
+                        first,
+                        current,
+                        &nb,
+                        projections,
+                        corrections,
+                        rhs,
+                    );
+                    for (j, rhs) in (first..).zip(rhs) {
+                        let members = constraint.membership(lists, j);
+                        *rhs = predicted[j] * mass + (current[j] * members + *rhs) * dt2k;
+                    }
+                };
+                if single_sweep {
+                    let omega = if accelerate {
+                        chebyshev.next_weight(outer)
+                    } else {
+                        1.0
+                    };
+                    let sweep = Sweep {
+                        diagonal: &b.system.diagonal,
+                        current,
+                        previous: &b.previous,
+                        chebyshev: (accelerate && chebyshev.changes(omega))
+                            .then_some((&*chebyshev, omega)),
+                    };
+                    displacement = b
+                        .rhs
+                        .par_chunks_mut(CHUNK)
+                        .zip(b.next.par_chunks_mut(CHUNK))
+                        .enumerate()
+                        .map(|(chunk, (rhs, next))| {
+                            fill_rhs(chunk, rhs);
+                            sweep.apply(chunk * CHUNK, rhs, next)
+                        })
+                        .reduce(|| f64::NEG_INFINITY, reduce::nan_max);
+                    inner += 1;
+                } else {
+                    b.rhs
+                        .par_chunks_mut(CHUNK)
+                        .enumerate()
+                        .for_each(|(chunk, rhs)| fill_rhs(chunk, rhs));
+                    b.next.copy_from_slice(&b.current);
+                    inner += solver.solve(&b.system, &b.rhs, &mut b.next);
+                    if accelerate {
+                        let omega = chebyshev.next_weight(outer);
+                        chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
+                    }
+                    displacement = max_distance(&b.next, &b.current);
                 }
-                displacement = max_distance(&b.next, &b.current);
                 b.displacements.push(displacement);
 
                 // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
@@ -340,6 +368,37 @@ fn permute<T: Copy + Send + Sync + Default>(
     std::mem::swap(data, scratch);
 }
 
+/// The global step of a solver that is one Jacobi sweep on the diagonal system, fused with
+/// Chebyshev's extrapolation and the displacement, for the particles of one chunk.
+struct Sweep<'a> {
+    /// Â_jj (kg).
+    diagonal: &'a [f64],
+    /// X^(k) and X^(k−1) (m).
+    current: &'a [Vec3],
+    previous: &'a [Vec3],
+    /// The recurrence and its weight ω, when the extrapolation changes the iterate.
+    chebyshev: Option<(&'a Chebyshev, f64)>,
+}
+
+impl Sweep<'_> {
+    /// Writes X^(k+1)_j for the particles `first..` of the right-hand sides `rhs` (kg·m) into
+    /// `next` (m): the sweep X_j + (b_j − Â_jj·X_j)/Â_jj, bitwise as [`crate::solver::Jacobi`]
+    /// computes it, then extrapolated. Returns max_j |X^(k+1)_j − X^(k)_j| (m) over the chunk.
+    fn apply(&self, first: usize, rhs: &[Vec3], next: &mut [Vec3]) -> f64 {
+        let mut largest = f64::NEG_INFINITY;
+        for (j, (b, next)) in (first..).zip(rhs.iter().zip(next)) {
+            let (x, d) = (self.current[j], self.diagonal[j]);
+            let mut plain = x + (b - x * d) / d;
+            if let Some((chebyshev, omega)) = self.chebyshev {
+                plain = chebyshev.extrapolated(omega, plain, x, self.previous[j]);
+            }
+            *next = plain;
+            largest = reduce::nan_max(largest, (plain - x).norm());
+        }
+        largest
+    }
+}
+
 /// max_i |a_i − b_i| (m).
 fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
     reduce::max_over(a.len(), |i| (a[i] - b[i]).norm())
@@ -369,6 +428,7 @@ fn xsph(
 #[cfg(test)]
 mod tests {
     use crate::boundary::Aabb;
+    use crate::solver::{GlobalSolver, Jacobi, SystemMatrix};
     use crate::{Params, Vec3, World};
 
     fn small_dam_break() -> World {
@@ -436,6 +496,24 @@ mod tests {
     #[test]
     fn avx2_builds_match_the_portable_ones() {
         steps_bitwise_alike(|w| w.constraint.portable = true);
+    }
+
+    /// A single Jacobi sweep that does not say so ([`GlobalSolver::single_diagonal_sweep`]
+    /// false), so that the step computes the right-hand side, the solve, the extrapolation
+    /// and the displacement in separate passes.
+    struct SeparateSweep(Jacobi);
+
+    impl GlobalSolver for SeparateSweep {
+        fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
+            self.0.solve(matrix, b, x)
+        }
+    }
+
+    /// The fused pass of a single-sweep solver (Chebyshev here) must give the trajectory of
+    /// the separate passes, bit for bit.
+    #[test]
+    fn fused_sweep_matches_separate_passes() {
+        steps_bitwise_alike(|w| w.solver = Box::new(SeparateSweep(Jacobi::single_sweep())));
     }
 
     /// Skipping the density evaluation after a first projection step that the Taylor bound

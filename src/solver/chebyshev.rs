@@ -121,20 +121,31 @@ impl Chebyshev {
     /// X^(k+1) = ω(γ(X̃^(k+1) − X^(k)) + X^(k) − X^(k−1)) + X^(k−1).
     /// With ω = γ = 1 it leaves `next` bitwise unchanged.
     pub fn extrapolate(&self, omega: f64, next: &mut [Vec3], current: &[Vec3], previous: &[Vec3]) {
-        let gamma = self.params.gamma;
-        if omega == 1.0 && gamma == 1.0 {
+        if !self.changes(omega) {
             return;
         }
         next.par_iter_mut()
             .zip(current.par_iter().zip(previous.par_iter()))
-            .for_each(|(n, (c, p))| {
-                *n = if gamma == 1.0 {
-                    // Momentum form of the same update: X̃ + (ω − 1)(X̃ − X^(k−1)).
-                    *n + (*n - p) * (omega - 1.0)
-                } else {
-                    p + ((*n - c) * gamma + c - p) * omega
-                };
-            });
+            .for_each(|(n, (c, p))| *n = self.extrapolated(omega, *n, *c, *p));
+    }
+
+    /// Whether extrapolating with weight `omega` changes an iterate (false for ω = γ = 1).
+    #[inline]
+    pub fn changes(&self, omega: f64) -> bool {
+        omega != 1.0 || self.params.gamma != 1.0
+    }
+
+    /// One particle of [`Chebyshev::extrapolate`]: X^(k+1) (m) from the plain iterate
+    /// `plain` = X̃^(k+1), `current` = X^(k) and `previous` = X^(k−1) (m), with weight `omega`.
+    #[inline]
+    pub fn extrapolated(&self, omega: f64, plain: Vec3, current: Vec3, previous: Vec3) -> Vec3 {
+        let gamma = self.params.gamma;
+        if gamma == 1.0 {
+            // Momentum form of the same update: X̃ + (ω − 1)(X̃ − X^(k−1)).
+            plain + (plain - previous) * (omega - 1.0)
+        } else {
+            previous + ((plain - current) * gamma + current - previous) * omega
+        }
     }
 }
 

@@ -35,9 +35,13 @@ impl Jacobi {
 impl GlobalSolver for Jacobi {
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
         self.residual.resize(x.len(), Vec3::zeros());
-        let b_norm = reduce::sum(b, |v| v.norm_squared()).sqrt();
+        let b_norm = if self.check_residual {
+            reduce::sum(b, |v| v.norm_squared()).sqrt()
+        } else {
+            0.0
+        };
         let mut sweeps = 0;
-        loop {
+        while sweeps < self.max_sweeps {
             matrix.apply(x, &mut self.residual);
             self.residual
                 .par_iter_mut()
@@ -46,17 +50,19 @@ impl GlobalSolver for Jacobi {
             if self.check_residual {
                 let r_norm = reduce::sum(&self.residual, |v| v.norm_squared()).sqrt();
                 if r_norm <= RESIDUAL_TOLERANCE * b_norm {
-                    return sweeps;
+                    break;
                 }
-            }
-            if sweeps == self.max_sweeps {
-                return sweeps;
             }
             x.par_iter_mut()
                 .zip(self.residual.par_iter().zip(matrix.diagonal().par_iter()))
                 .for_each(|(x, (r, d))| *x += r / *d);
             sweeps += 1;
         }
+        sweeps
+    }
+
+    fn single_diagonal_sweep(&self) -> bool {
+        self.max_sweeps == 1 && !self.check_residual
     }
 }
 

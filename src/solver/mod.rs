@@ -60,6 +60,12 @@ pub trait GlobalSolver: Send + Sync {
     fn prepare(&mut self, _matrix: &dyn SystemMatrix) {}
     /// Solves A·x = b with `x` holding the warm start; returns the inner iterations used.
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize;
+    /// True when every solve is exactly one Jacobi sweep x ← x + D⁻¹(b − Ax), which on a
+    /// [`DiagonalSystem`] is x_j + (b_j − Â_jj·x_j)/Â_jj: the time step may then compute it
+    /// in the same pass as the right-hand side (bitwise the same result).
+    fn single_diagonal_sweep(&self) -> bool {
+        false
+    }
 }
 
 /// Relative residual ‖b − Ax‖ ≤ this·‖b‖ ends the converging solvers (ALGORITHM.md §3.4).

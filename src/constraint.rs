@@ -673,14 +673,15 @@ impl DensityConstraint {
         let c = corrections;
         projections.resize(x.len(), Projection::default());
         c.lambdas.resize(x.len(), 0.0);
-        projections
+        let any_kept = projections
             .par_chunks_mut(CHUNK)
             .zip(c.lambdas.par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(chunk, (outs, lambdas))| {
+            .map(|(chunk, (outs, lambdas))| {
                 SCRATCH.with_borrow_mut(|scratch| {
                     // Corrections written here are dropped; the buffer only grows.
                     let mut dp = std::mem::take(&mut scratch.dp);
+                    let mut kept = false;
                     for (k, (out, lambda)) in outs.iter_mut().zip(lambdas).enumerate() {
                         let i = chunk * CHUNK + k;
                         let members = nb.fluid.count(i) + 1;
@@ -689,20 +690,25 @@ impl DensityConstraint {
                         }
                         self.project_one(i, x, nb, &mut dp[..members], out, scratch);
                         *lambda = if out.materialized { 0.0 } else { out.lambda };
+                        kept |= out.materialized;
                     }
                     scratch.dp = dp;
-                });
-            });
+                    kept
+                })
+            })
+            .reduce(|| false, |a, b| a || b);
 
         // The flags were set only if the last local step kept a segment (rarely); only then
         // are they cleared.
         let flags_set = !c.owners.is_empty();
         c.owners.clear();
-        c.owners.par_extend(
-            (0..projections.len() as u32)
-                .into_par_iter()
-                .filter(|&i| projections[i as usize].materialized),
-        );
+        if any_kept {
+            c.owners.par_extend(
+                (0..projections.len() as u32)
+                    .into_par_iter()
+                    .filter(|&i| projections[i as usize].materialized),
+            );
+        }
         if c.near_kept.len() != projections.len() || flags_set {
             c.near_kept.clear();
             c.near_kept.resize(projections.len(), false);

@@ -91,10 +91,14 @@ impl UniformGrid {
 
     /// True when every point lies inside the grid's domain, i.e. no point needs clamping.
     pub fn covers(&self, points: &[Vec3]) -> bool {
+        points.par_iter().all(|p| self.contains(p))
+    }
+
+    /// True when `p` lies inside the grid's domain (false for a NaN coordinate).
+    #[inline]
+    fn contains(&self, p: &Vec3) -> bool {
         let (lo, hi) = (self.origin, self.upper_corner());
-        points
-            .par_iter()
-            .all(|p| (0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a]))
+        (0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a])
     }
 
     fn upper_corner(&self) -> Vec3 {
@@ -124,14 +128,19 @@ impl UniformGrid {
     }
 
     /// Counting sort of `points` by cell in Z-order. Writes `order` (sorted slot → input index,
-    /// stable) and the table of cell ranges.
-    pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) {
+    /// stable) and the table of cell ranges. Returns whether every point lies inside the
+    /// grid's domain ([`UniformGrid::covers`]), from the same pass.
+    pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) -> bool {
         let ranks = &mut table.ranks;
         ranks.resize(points.len(), 0);
-        ranks
+        let covered = ranks
             .par_iter_mut()
             .zip(points.par_iter())
-            .for_each(|(r, p)| *r = self.rank(self.cell_of(p)) as u32);
+            .map(|(r, p)| {
+                *r = self.rank(self.cell_of(p)) as u32;
+                self.contains(p)
+            })
+            .reduce(|| true, |a, b| a && b);
         let starts = &mut table.cell_start;
         starts.clear();
         starts.resize(self.cell_count() + 1, 0);
@@ -151,6 +160,7 @@ impl UniformGrid {
             order[*slot as usize] = i as u32;
             *slot += 1;
         }
+        covered
     }
 
     /// For every query point, the indices of `points` (already in the order of `table`) within

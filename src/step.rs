@@ -152,7 +152,18 @@ impl World {
                 .zip(fluid.positions.par_iter().zip(fluid.velocities.par_iter()))
                 .for_each(|(s, (x, v))| *s = x + v * dt + gravity * (dt * dt));
         });
-        self.prepare_grid(&buffers.predicted);
+        // 2. Sort into Z-order; the sort's pass also tells whether the grid still covers s.
+        self.prepare_grid(&buffers.predicted, false);
+        let sort = |world: &World, b: &mut StepBuffers| {
+            let grid = world.grid.as_ref().expect("prepare_grid builds the grid");
+            world
+                .pool
+                .install(|| grid.sort(&b.predicted, &mut b.order, &mut b.table))
+        };
+        if !sort(self, &mut buffers) && !self.grid_capped {
+            self.prepare_grid(&buffers.predicted, true);
+            sort(self, &mut buffers);
+        }
         let mut timings = StepTimings::default();
         let World {
             params,
@@ -168,8 +179,7 @@ impl World {
         let grid = grid.as_ref().expect("prepare_grid builds the grid");
         let stats = pool.install(|| {
             let b = &mut buffers;
-            // 2. Sort into Z-order (all per-particle arrays), then search on s.
-            grid.sort(&b.predicted, &mut b.order, &mut b.table);
+            // Reorder all per-particle arrays, then search on s.
             permute(&b.order, &mut fluid.positions, &mut b.scratch);
             permute(&b.order, &mut fluid.velocities, &mut b.scratch);
             permute(&b.order, &mut b.predicted, &mut b.scratch);

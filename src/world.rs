@@ -433,14 +433,13 @@ impl World {
             .collect()
     }
 
-    /// Makes sure the grid covers all particles and the boundary is sorted with volumes.
-    /// The grid is rebuilt (with slack) when particles leave it, unless it already hit its
-    /// cell limit; then outlying particles are clamped into border cells, which stays correct.
-    pub(crate) fn prepare_grid(&mut self, points: &[Vec3]) {
-        let outgrown = match &self.grid {
-            None => true,
-            Some(g) => !self.grid_capped && !self.pool.install(|| g.covers(points)),
-        };
+    /// Makes sure there is a grid and the boundary is sorted with volumes. The grid is
+    /// (re)built, with slack around `points` and the boundary, when there is none, when the
+    /// boundary changed, or when `outgrown` (some of `points` lie outside it) unless it
+    /// already hit its cell limit; then outlying particles are clamped into border cells,
+    /// which stays correct.
+    pub(crate) fn prepare_grid(&mut self, points: &[Vec3], outgrown: bool) {
+        let outgrown = self.grid.is_none() || (outgrown && !self.grid_capped);
         if outgrown || self.boundary.dirty {
             let bounds = [points, &self.boundary.positions]
                 .iter()

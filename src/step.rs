@@ -508,6 +508,30 @@ mod tests {
         steps_bitwise_alike(|w| w.constraint.portable = true);
     }
 
+    /// Predicted positions that leave the grid make the step rebuild it around them before
+    /// the search (read from the sort's pass), so every step's grid covers its prediction.
+    #[test]
+    fn grid_follows_particles_that_leave_it() {
+        let mut world = World::new(Params::default()).unwrap();
+        let velocity = Vec3::new(30.0, 0.0, 0.0);
+        world
+            .add_fluid_block(Vec3::zeros(), [2, 2, 2], velocity)
+            .unwrap();
+        let mut first = None;
+        for _ in 0..40 {
+            world.step().unwrap();
+            let grid = world.grid.as_ref().unwrap();
+            assert!(grid.covers(&world.buffers.predicted));
+            first.get_or_insert(grid.parts());
+        }
+        let x = world.positions()[0].x;
+        assert!(
+            x > 0.3,
+            "the block must outrun its first grid (at x = {x} m)"
+        );
+        assert_ne!(world.grid.as_ref().map(|g| g.parts()), first);
+    }
+
     /// A single Jacobi sweep that does not say so ([`GlobalSolver::single_diagonal_sweep`]
     /// false), so that the step computes the right-hand side, the solve, the extrapolation
     /// and the displacement in separate passes.

@@ -379,7 +379,11 @@ impl Block<'_> {
                         for x in c[0].saturating_sub(1)..=(c[0] + 1).min(grid.dims[0] - 1) {
                             let rank = grid.rank([x, y, z]);
                             let cells = &self.table.cell_start;
-                            ranges.push(cells[rank] as usize..cells[rank + 1] as usize);
+                            let (start, end) = (cells[rank] as usize, cells[rank + 1] as usize);
+                            // Empty cells are left out (most cells of the boundary's table).
+                            if start < end {
+                                ranges.push(start..end);
+                            }
                         }
                     }
                 }

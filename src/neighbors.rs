@@ -91,14 +91,13 @@ impl UniformGrid {
 
     /// True when every point lies inside the grid's domain, i.e. no point needs clamping.
     pub fn covers(&self, points: &[Vec3]) -> bool {
-        points.par_iter().all(|p| self.contains(p))
+        let domain = self.domain();
+        points.par_iter().all(|p| inside(p, &domain))
     }
 
-    /// True when `p` lies inside the grid's domain (false for a NaN coordinate).
-    #[inline]
-    fn contains(&self, p: &Vec3) -> bool {
-        let (lo, hi) = (self.origin, self.upper_corner());
-        (0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a])
+    /// The lower and upper corner of the grid's domain (m).
+    fn domain(&self) -> (Vec3, Vec3) {
+        (self.origin, self.upper_corner())
     }
 
     fn upper_corner(&self) -> Vec3 {
@@ -133,12 +132,13 @@ impl UniformGrid {
     pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) -> bool {
         let ranks = &mut table.ranks;
         ranks.resize(points.len(), 0);
+        let domain = self.domain();
         let covered = ranks
             .par_iter_mut()
             .zip(points.par_iter())
             .map(|(r, p)| {
                 *r = self.rank(self.cell_of(p)) as u32;
-                self.contains(p)
+                inside(p, &domain)
             })
             .reduce(|| true, |a, b| a && b);
         let starts = &mut table.cell_start;
@@ -429,6 +429,12 @@ impl Block<'_> {
 thread_local! {
     /// The candidate points of a block's current cell and their indices, per thread.
     static CANDIDATES: std::cell::Cell<(Coordinates, Vec<u32>)> = Default::default();
+}
+
+/// True when `p` lies in the box `[lo, hi)` (false for a NaN coordinate).
+#[inline]
+fn inside(p: &Vec3, (lo, hi): &(Vec3, Vec3)) -> bool {
+    (0..3).all(|a| p[a] >= lo[a] && p[a] < hi[a])
 }
 
 /// Interleaves the low 21 bits of x, y, z into a 63-bit Morton code.

@@ -174,14 +174,29 @@ impl UniformGrid {
         exclude_self: bool,
         out: &mut NeighborLists,
     ) {
+        let mut coordinates = std::mem::take(&mut out.coordinates);
+        coordinates.fill(points);
+        self.search_in(table, &coordinates, queries, radius, exclude_self, out);
+        out.coordinates = coordinates;
+    }
+
+    /// [`UniformGrid::search`] among points already copied by component (for points that
+    /// do not move, such as the boundary's, copied once).
+    pub fn search_in(
+        &self,
+        table: &CellTable,
+        points: &PointsByComponent,
+        queries: &[Vec3],
+        radius: f64,
+        exclude_self: bool,
+        out: &mut NeighborLists,
+    ) {
         assert!(
             radius <= self.cell_size,
             "search radius exceeds the cell size"
         );
         let r2 = radius * radius;
         let blocks = queries.len().div_ceil(BLOCK);
-        let mut coordinates = std::mem::take(&mut out.coordinates);
-        coordinates.fill(points);
         out.scratch.resize_with(blocks, Default::default);
         out.scratch
             .par_iter_mut()
@@ -192,13 +207,12 @@ impl UniformGrid {
                 let block = Block {
                     grid: self,
                     table,
-                    points: &coordinates,
+                    points,
                     r2,
                     exclude_self: exclude_self.then_some(first),
                 };
                 block.search(queries, counts, found);
             });
-        out.coordinates = coordinates;
         out.offsets.clear();
         out.offsets.push(0);
         let mut total = 0u32;
@@ -242,7 +256,7 @@ pub struct NeighborLists {
     pub indices: Vec<u32>,
     scratch: Vec<(Vec<u32>, Vec<u32>)>,
     /// The searched points by component, for [`UniformGrid::search`].
-    coordinates: Coordinates,
+    coordinates: PointsByComponent,
 }
 
 impl NeighborLists {
@@ -302,15 +316,15 @@ pub fn par_segments_zip_mut<T: Send, U: Send>(
 /// Points by component (m): a structure of arrays, so that the distance tests of a cell's
 /// points run several lanes wide.
 #[derive(Clone, Debug, Default)]
-struct Coordinates {
+pub struct PointsByComponent {
     x: Vec<f64>,
     y: Vec<f64>,
     z: Vec<f64>,
 }
 
-impl Coordinates {
+impl PointsByComponent {
     /// Replaces the contents with the points of `ranges` of `points`, in that order.
-    fn copy_ranges(&mut self, points: &Coordinates, ranges: &[std::ops::Range<usize>]) {
+    fn copy_ranges(&mut self, points: &PointsByComponent, ranges: &[std::ops::Range<usize>]) {
         for (out, from) in [
             (&mut self.x, &points.x),
             (&mut self.y, &points.y),
@@ -323,15 +337,14 @@ impl Coordinates {
         }
     }
 
-    /// Copies `points` in.
-    fn fill(&mut self, points: &[Vec3]) {
-        for (axis, out) in [&mut self.x, &mut self.y, &mut self.z]
-            .into_iter()
-            .enumerate()
-        {
-            out.clear();
-            out.par_extend(points.par_iter().map(|p| p[axis]));
+    /// Replaces the contents with `points` (m), in one parallel pass.
+    pub fn fill(&mut self, points: &[Vec3]) {
+        for out in [&mut self.x, &mut self.y, &mut self.z] {
+            out.resize(points.len(), 0.0);
         }
+        (&mut self.x[..], &mut self.y[..], &mut self.z[..], points)
+            .into_par_iter()
+            .for_each(|(x, y, z, p)| (*x, *y, *z) = (p.x, p.y, p.z));
     }
 }
 
@@ -339,7 +352,7 @@ impl Coordinates {
 struct Block<'a> {
     grid: &'a UniformGrid,
     table: &'a CellTable,
-    points: &'a Coordinates,
+    points: &'a PointsByComponent,
     /// Squared search radius (m²).
     r2: f64,
     /// With `Some(first)`, query k of the block is point `first + k` and skips itself.
@@ -428,7 +441,7 @@ impl Block<'_> {
 
 thread_local! {
     /// The candidate points of a block's current cell and their indices, per thread.
-    static CANDIDATES: std::cell::Cell<(Coordinates, Vec<u32>)> = Default::default();
+    static CANDIDATES: std::cell::Cell<(PointsByComponent, Vec<u32>)> = Default::default();
 }
 
 /// True when `p` lies in the box `[lo, hi)` (false for a NaN coordinate).

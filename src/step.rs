@@ -193,9 +193,9 @@ impl World {
                 true,
                 &mut b.fluid_lists,
             );
-            grid.search(
+            grid.search_in(
                 &boundary.table,
-                &boundary.positions,
+                &boundary.by_component,
                 &b.predicted,
                 h,
                 false,

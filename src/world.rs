@@ -4,7 +4,7 @@
 use crate::boundary::{Aabb, akinci_volumes, sample_box_walls};
 use crate::constraint::DensityConstraint;
 use crate::kernel::CubicKernel;
-use crate::neighbors::{CellTable, UniformGrid};
+use crate::neighbors::{CellTable, PointsByComponent, UniformGrid};
 use crate::params::{Params, SolverKind};
 use crate::solver::{Chebyshev, GlobalSolver, linear_solver};
 use crate::stats::StepStats;
@@ -28,6 +28,8 @@ pub(crate) struct Boundary {
     /// ψ_b = ρ0·V_b (kg), valid unless `dirty`.
     pub psi: Vec<f64>,
     pub table: CellTable,
+    /// `positions` by component, for the neighbour search (valid unless `dirty`).
+    pub by_component: PointsByComponent,
     /// Set when particles were added or the grid changed: sort and volumes must be redone.
     pub dirty: bool,
 }
@@ -476,6 +478,7 @@ impl World {
         self.pool.install(|| {
             grid.sort(&b.positions, &mut order, &mut b.table);
             b.positions = order.iter().map(|&i| b.positions[i as usize]).collect();
+            b.by_component.fill(&b.positions);
             let volumes = akinci_volumes(grid, &b.table, &b.positions, &self.constraint.kernel);
             b.psi = volumes
                 .iter()

@@ -98,8 +98,11 @@ pub struct Corrections {
     data: Vec<Vec3>,
     /// λ_i of every single-step projection, 0 for the others (inactive or kept), in a
     /// compact array (8 bytes per particle, against 40 for a [`Projection`]): the gather
-    /// reads it for every neighbour.
+    /// reads it for every neighbour that `moved` marks.
     lambdas: Vec<f64>,
+    /// 1 where `lambdas` is not 0: one byte per particle, so that the gather's scan of a
+    /// particle's neighbours reads an array that stays in the nearest cache.
+    moved: Vec<u8>,
     /// Whether particle j is a member of a stencil whose projection kept a segment: only
     /// then does its gather look for segments.
     near_kept: Vec<bool>,
@@ -673,16 +676,20 @@ impl DensityConstraint {
         let c = corrections;
         projections.resize(x.len(), Projection::default());
         c.lambdas.resize(x.len(), 0.0);
+        c.moved.resize(x.len(), 0);
         let any_kept = projections
             .par_chunks_mut(CHUNK)
             .zip(c.lambdas.par_chunks_mut(CHUNK))
+            .zip(c.moved.par_chunks_mut(CHUNK))
             .enumerate()
-            .map(|(chunk, (outs, lambdas))| {
+            .map(|(chunk, ((outs, lambdas), moved))| {
                 SCRATCH.with_borrow_mut(|scratch| {
                     // Corrections written here are dropped; the buffer only grows.
                     let mut dp = std::mem::take(&mut scratch.dp);
                     let mut kept = false;
-                    for (k, (out, lambda)) in outs.iter_mut().zip(lambdas).enumerate() {
+                    for (k, ((out, lambda), moved)) in
+                        outs.iter_mut().zip(lambdas).zip(moved).enumerate()
+                    {
                         let i = chunk * CHUNK + k;
                         let members = nb.fluid.count(i) + 1;
                         if dp.len() < members {
@@ -690,6 +697,7 @@ impl DensityConstraint {
                         }
                         self.project_one(i, x, nb, &mut dp[..members], out, scratch);
                         *lambda = if out.materialized { 0.0 } else { out.lambda };
+                        *moved = u8::from(*lambda != 0.0);
                         kept |= out.materialized;
                     }
                     scratch.dp = dp;
@@ -771,10 +779,11 @@ impl DensityConstraint {
         ) -> Vec3 where !self.portable => gathered_correction_portable
     }
 
-    /// The body of [`Self::gathered_corrections`]. A first pass lists, without branches, the
-    /// neighbours i whose single-step projection moved j (λ_i ≠ 0; about a quarter of them
-    /// in a flow, in no predictable order); a second evaluates their λ_i∇W(x_j − x_i) by
-    /// component, four at a time. Kept segments are read apart (rare).
+    /// The body of [`Self::gathered_corrections`]. A first pass lists, without branches and
+    /// from one byte per particle, the neighbours i whose single-step projection moved j
+    /// (λ_i ≠ 0; about a quarter of them in a flow, in no predictable order); a second
+    /// evaluates their λ_i∇W(x_j − x_i) by component, four at a time. Kept segments are read
+    /// apart (rare).
     #[inline(always)]
     fn gathered_correction_portable(
         &self,
@@ -789,11 +798,12 @@ impl DensityConstraint {
         gather.resize(neighbors.len());
         let mut active = 0;
         for &i in neighbors {
-            let lambda = corrections.lambdas[i as usize];
             // Written for every neighbour, kept only where the count moves on.
             gather.ids[active] = i;
-            gather.lambdas[active] = lambda;
-            active += usize::from(lambda != 0.0);
+            active += usize::from(corrections.moved[i as usize]);
+        }
+        for (lambda, &i) in gather.lambdas[..active].iter_mut().zip(&gather.ids) {
+            *lambda = corrections.lambdas[i as usize];
         }
         let g = gather;
         let xj = x[j];

@@ -180,8 +180,12 @@ impl UniformGrid {
         out.coordinates = coordinates;
     }
 
-    /// [`UniformGrid::search`] among points already copied by component (for points that
-    /// do not move, such as the boundary's, copied once).
+    /// [`UniformGrid::search`] among `points` already copied by component (for points that
+    /// do not move, such as the boundary's, copied once): they must be the points `table`
+    /// sorted, in its order.
+    ///
+    /// # Panics
+    /// If `points` and `table` differ in length, or `radius` exceeds the cell size.
     pub fn search_in(
         &self,
         table: &CellTable,
@@ -194,6 +198,11 @@ impl UniformGrid {
         assert!(
             radius <= self.cell_size,
             "search radius exceeds the cell size"
+        );
+        assert_eq!(
+            points.x.len(),
+            table.ranks.len(),
+            "search: not the points the table sorted"
         );
         let r2 = radius * radius;
         let blocks = queries.len().div_ceil(BLOCK);
@@ -547,16 +556,40 @@ mod tests {
             "test should exercise many pairs, got {total}"
         );
 
-        // Queries against a second point set (as for boundary particles).
+        // Queries against a second point set copied by component once (as the boundary's),
+        // searched twice with different queries.
         let others = random_points(1500, 3, 1.0);
         let sorted_others = sorted_copy(&grid, &others, &mut table);
-        grid.search(&table, &sorted_others, &sorted, radius, false, &mut lists);
-        for (i, p) in sorted.iter().enumerate() {
-            let brute: Vec<u32> = (0..sorted_others.len() as u32)
-                .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
-                .collect();
-            assert_eq!(lists.of(i), brute.as_slice());
+        let mut prepared = PointsByComponent::default();
+        prepared.fill(&sorted_others);
+        for queries in [&sorted, &random_points(700, 8, 1.0)] {
+            grid.search_in(&table, &prepared, queries, radius, false, &mut lists);
+            assert_eq!(lists.len(), queries.len());
+            for (i, p) in queries.iter().enumerate() {
+                let brute: Vec<u32> = (0..sorted_others.len() as u32)
+                    .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
+                    .collect();
+                assert_eq!(lists.of(i), brute.as_slice());
+            }
         }
+    }
+
+    #[test]
+    #[should_panic(expected = "not the points the table sorted")]
+    fn search_rejects_points_of_another_table() {
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &random_points(50, 1, 1.0), &mut table);
+        let mut prepared = PointsByComponent::default();
+        prepared.fill(&sorted[..40]);
+        grid.search_in(
+            &table,
+            &prepared,
+            &sorted,
+            0.1,
+            false,
+            &mut NeighborLists::default(),
+        );
     }
 
     #[test]

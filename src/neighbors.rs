@@ -574,6 +574,8 @@ mod tests {
         }
     }
 
+    /// A point set that is not the one the table sorted is refused with a clear message,
+    /// not searched out of bounds.
     #[test]
     #[should_panic(expected = "not the points the table sorted")]
     fn search_rejects_points_of_another_table() {

@@ -67,10 +67,10 @@ pub fn artifacts(s: &RunSummary) -> Vec<Artifact> {
     if above(s.density_error_max_percent, MAX_DENSITY_ERROR_LIMIT_PERCENT) {
         found.push(Artifact::MaxDensityError(s.density_error_max_percent));
     }
-    if let Some(rise) = s.energy_rise() {
-        if above(rise, ENERGY_RISE_LIMIT) {
-            found.push(Artifact::EnergyRise(rise));
-        }
+    if let Some(rise) = s.energy_rise()
+        && above(rise, ENERGY_RISE_LIMIT)
+    {
+        found.push(Artifact::EnergyRise(rise));
     }
     found
 }

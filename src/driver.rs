@@ -104,14 +104,14 @@ impl Runner {
     /// Starts a run of `world` for `length`; a duration or end time that is negative or not
     /// finite is an error.
     pub fn new(world: &World, length: RunLength) -> Result<Self, Error> {
-        if let RunLength::Duration(d) | RunLength::UntilTime(d) = length {
-            if !(d.is_finite() && d >= 0.0) {
-                return Err(Error::invalid(
-                    "duration",
-                    d,
-                    "must be a non-negative finite number",
-                ));
-            }
+        if let RunLength::Duration(d) | RunLength::UntilTime(d) = length
+            && !(d.is_finite() && d >= 0.0)
+        {
+            return Err(Error::invalid(
+                "duration",
+                d,
+                "must be a non-negative finite number",
+            ));
         }
         let datum = energy_datum(world);
         let mut acc = RunAccumulator::default();

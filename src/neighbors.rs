@@ -369,16 +369,55 @@ struct Block<'a> {
 }
 
 impl Block<'_> {
-    crate::simd::avx2_dispatch! {
-        /// Appends the neighbours of every query to `found` and their number to `counts`
-        /// (four distance tests per instruction in the AVX2 build; the same lists).
-        fn search / search_avx2(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>)
-            where true => search_portable
+    /// Appends the neighbours of every query to `found` and their number to `counts`: eight
+    /// distance tests per instruction in the AVX-512 build, four in the AVX2 build, the same
+    /// lists from every build (tested).
+    fn search(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::has_avx512() {
+            // SAFETY: the processor supports the build's features, checked just above.
+            return unsafe { self.search_avx512(queries, counts, found) };
+        }
+        self.search_avx2_or_portable(queries, counts, found)
     }
 
-    /// The body of [`Block::search`], inlined into both builds.
+    crate::simd::avx2_dispatch! {
+        /// [`Block::search`] without AVX-512: the AVX2 build where the processor has it.
+        fn search_avx2_or_portable / search_avx2(
+            &self,
+            queries: &[Vec3],
+            counts: &mut Vec<u32>,
+            found: &mut Vec<u32>,
+        ) where true => search_portable
+    }
+
+    /// The body of [`Block::search`] with the portable distance tests, inlined into the
+    /// portable and the AVX2 build.
     #[inline(always)]
     fn search_portable(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
+        self.search_with::<false>(queries, counts, found)
+    }
+
+    /// The AVX-512 build of [`Block::search`].
+    ///
+    /// # Safety
+    /// The processor must support AVX-512 F, VL, DQ and BW ([`crate::simd::has_avx512`]).
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw")]
+    unsafe fn search_avx512(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
+        self.search_with::<true>(queries, counts, found)
+    }
+
+    /// The body of [`Block::search`]; with `AVX512` the distance tests run eight lanes wide
+    /// and the neighbours found are compressed into `found` a vector at a time (only
+    /// instantiated so by [`Block::search_avx512`]).
+    #[inline(always)]
+    fn search_with<const AVX512: bool>(
+        &self,
+        queries: &[Vec3],
+        counts: &mut Vec<u32>,
+        found: &mut Vec<u32>,
+    ) {
         let grid = self.grid;
         let p = self.points;
         counts.clear();
@@ -419,33 +458,126 @@ impl Block<'_> {
             let own = self
                 .exclude_self
                 .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
-            let cand = &candidates;
-            for lo in (0..ids.len()).step_by(64) {
-                // The distance tests of up to 64 points into the bits of a mask (they
-                // vectorise), then one push per set bit (no branch per candidate).
-                let hi = (lo + 64).min(ids.len());
-                let mut mask = 0u64;
-                for (bit, ((x, y), z)) in cand.x[lo..hi]
-                    .iter()
-                    .zip(&cand.y[lo..hi])
-                    .zip(&cand.z[lo..hi])
-                    .enumerate()
-                {
-                    let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
-                    mask |= u64::from(dx * dx + dy * dy + dz * dz <= self.r2) << bit;
-                }
-                if let Some(own) = own.filter(|own| (lo..hi).contains(own)) {
-                    mask &= !(1 << (own - lo));
-                }
-                while mask != 0 {
-                    found.push(ids[lo + mask.trailing_zeros() as usize]);
-                    mask &= mask - 1;
-                }
+            #[cfg(target_arch = "x86_64")]
+            if AVX512 {
+                // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
+                // processor has AVX-512; `ids` and `candidates` are equally long.
+                unsafe { push_within_avx512(q, &candidates, &ids, own, self.r2, found) };
+                counts.push((found.len() - start) as u32);
+                continue;
             }
+            push_within_portable(q, &candidates, &ids, own, self.r2, found);
             counts.push((found.len() - start) as u32);
         }
         CANDIDATES.set((candidates, ids));
     }
+}
+
+/// Appends to `found`, in order, the `ids` of the `candidates` within √`r2` (m) of `q`,
+/// except the candidate at index `own`.
+#[inline(always)]
+fn push_within_portable(
+    q: &Vec3,
+    candidates: &PointsByComponent,
+    ids: &[u32],
+    own: Option<usize>,
+    r2: f64,
+    found: &mut Vec<u32>,
+) {
+    let cand = candidates;
+    for lo in (0..ids.len()).step_by(64) {
+        // The distance tests of up to 64 points into the bits of a mask (they vectorise),
+        // then one push per set bit (no branch per candidate).
+        let hi = (lo + 64).min(ids.len());
+        let mut mask = 0u64;
+        for (bit, ((x, y), z)) in cand.x[lo..hi]
+            .iter()
+            .zip(&cand.y[lo..hi])
+            .zip(&cand.z[lo..hi])
+            .enumerate()
+        {
+            let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
+            mask |= u64::from(dx * dx + dy * dy + dz * dz <= r2) << bit;
+        }
+        if let Some(own) = own.filter(|own| (lo..hi).contains(own)) {
+            mask &= !(1 << (own - lo));
+        }
+        while mask != 0 {
+            found.push(ids[lo + mask.trailing_zeros() as usize]);
+            mask &= mask - 1;
+        }
+    }
+}
+
+/// [`push_within_portable`] eight candidates at a time: the same operations in the same
+/// order (so the same tests, bit for bit), a mask compare, and the ids that pass compressed
+/// to the front of a vector that is stored whole at the end of `found` (room for it is
+/// reserved; the entries past the ids kept are overwritten by the next store or left
+/// beyond the length).
+///
+/// # Safety
+/// The processor must support AVX-512 F and VL; `candidates` holds at least `ids.len()`
+/// points.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw")]
+#[inline]
+unsafe fn push_within_avx512(
+    q: &Vec3,
+    candidates: &PointsByComponent,
+    ids: &[u32],
+    own: Option<usize>,
+    r2: f64,
+    found: &mut Vec<u32>,
+) {
+    use std::arch::x86_64::*;
+    const WIDTH: usize = 8;
+    let n = ids.len();
+    debug_assert!(candidates.x.len() >= n && candidates.y.len() >= n && candidates.z.len() >= n);
+    found.reserve(n + WIDTH);
+    let mut len = found.len();
+    let out = found.as_mut_ptr();
+    let (qx, qy, qz) = (
+        _mm512_set1_pd(q.x),
+        _mm512_set1_pd(q.y),
+        _mm512_set1_pd(q.z),
+    );
+    let r2 = _mm512_set1_pd(r2);
+    let (x, y, z) = (
+        candidates.x.as_ptr(),
+        candidates.y.as_ptr(),
+        candidates.z.as_ptr(),
+    );
+    let mut lo = 0;
+    while lo < n {
+        let rest = n - lo;
+        let lanes: __mmask8 = if rest >= WIDTH {
+            0xff
+        } else {
+            (1u8 << rest) - 1
+        };
+        // SAFETY: masked loads read only lanes below `n`, within the arrays; the store
+        // writes `WIDTH` ids at `len` ≤ the old length + `lo`, within the reserved room.
+        unsafe {
+            let dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, x.add(lo)), qx);
+            let dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, y.add(lo)), qy);
+            let dz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, z.add(lo)), qz);
+            let d2 = _mm512_add_pd(
+                _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                _mm512_mul_pd(dz, dz),
+            );
+            let mut within = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(lanes, d2, r2);
+            if let Some(own) = own.filter(|own| (lo..lo + WIDTH).contains(own)) {
+                within &= !(1u8 << (own - lo));
+            }
+            let batch = _mm256_maskz_loadu_epi32(lanes, ids.as_ptr().add(lo).cast());
+            let kept = _mm256_maskz_compress_epi32(within, batch);
+            _mm256_storeu_si256(out.add(len).cast(), kept);
+            len += within.count_ones() as usize;
+        }
+        lo += WIDTH;
+    }
+    // SAFETY: the first `len` entries are initialised (the old ones, then the kept ids).
+    unsafe { found.set_len(len) };
 }
 
 thread_local! {
@@ -570,6 +702,54 @@ mod tests {
                     .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
                     .collect();
                 assert_eq!(lists.of(i), brute.as_slice());
+            }
+        }
+    }
+
+    /// Every build of the block search (portable, AVX2, AVX-512, as far as the processor
+    /// has them) finds the same lists, with and without skipping the query itself, on
+    /// points with dense clumps (several vectors and a partial one per candidate run).
+    #[test]
+    fn search_builds_find_the_same_lists() {
+        let radius = 0.1;
+        let mut pts = random_points(3000, 21, 1.0);
+        pts.extend(
+            random_points(250, 4, 0.05)
+                .into_iter()
+                .map(|p| p + Vec3::repeat(0.31)),
+        );
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &pts, &mut table);
+        let mut points = PointsByComponent::default();
+        points.fill(&sorted);
+        for exclude_self in [None, Some(0)] {
+            let block = Block {
+                grid: &grid,
+                table: &table,
+                points: &points,
+                r2: radius * radius,
+                exclude_self,
+            };
+            let run = |build: &dyn Fn(&mut Vec<u32>, &mut Vec<u32>)| {
+                let (mut counts, mut found) = (Vec::new(), Vec::new());
+                build(&mut counts, &mut found);
+                (counts, found)
+            };
+            let reference = run(&|c, f| block.search_portable(&sorted, c, f));
+            assert!(reference.1.len() > 20_000, "{} pairs", reference.1.len());
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the processor has AVX2.
+                    let avx2 = run(&|c, f| unsafe { block.search_avx2(&sorted, c, f) });
+                    assert_eq!(avx2, reference, "AVX2 build");
+                }
+                if crate::simd::has_avx512() {
+                    // SAFETY: the processor has the AVX-512 subsets.
+                    let avx512 = run(&|c, f| unsafe { block.search_avx512(&sorted, c, f) });
+                    assert_eq!(avx512, reference, "AVX-512 build");
+                }
             }
         }
     }

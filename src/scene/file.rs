@@ -253,12 +253,11 @@ fn json_error(e: serde_json::Error, path: &str, origin: Option<&Path>) -> Error 
     if let Some(key) = message
         .strip_prefix("unknown field `")
         .and_then(|rest| rest.split('`').next())
+        && let Some(parent) = path.strip_suffix(key)
     {
-        if let Some(parent) = path.strip_suffix(key) {
-            path = parent.strip_suffix('.').unwrap_or(".");
-            if path.is_empty() {
-                path = ".";
-            }
+        path = parent.strip_suffix('.').unwrap_or(".");
+        if path.is_empty() {
+            path = ".";
         }
     }
     let field = if syntax || path == "." { "scene" } else { path };
@@ -424,19 +423,19 @@ fn inline_number_arrays(json: &str) -> String {
             in_string = true;
         } else if b == b'[' {
             let rest = &json[i + 1..];
-            if let Some(end) = rest.find([']', '[', '{', '"']) {
-                if rest.as_bytes()[end] == b']' {
-                    let items: Vec<&str> = rest[..end]
-                        .split(',')
-                        .map(str::trim)
-                        .filter(|s| !s.is_empty())
-                        .collect();
-                    out.push('[');
-                    out.push_str(&items.join(", "));
-                    out.push(']');
-                    i += end + 2;
-                    continue;
-                }
+            if let Some(end) = rest.find([']', '[', '{', '"'])
+                && rest.as_bytes()[end] == b']'
+            {
+                let items: Vec<&str> = rest[..end]
+                    .split(',')
+                    .map(str::trim)
+                    .filter(|s| !s.is_empty())
+                    .collect();
+                out.push('[');
+                out.push_str(&items.join(", "));
+                out.push(']');
+                i += end + 2;
+                continue;
             }
         }
         // Copy the whole UTF-8 character starting here.

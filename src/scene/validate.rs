@@ -38,17 +38,17 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
         check_container(i, c, r)?;
     }
     for (i, o) in scene.obstacles.iter().enumerate() {
-        if let super::MeshSource::Generated(name) = &o.mesh {
-            if !super::obstacle::NAMES.contains(&name.as_str()) {
-                return Err(Error::invalid(
-                    format!("obstacles[{i}].generated"),
-                    format!("`{name}`"),
-                    &format!(
-                        "must name a generated mesh ({})",
-                        super::obstacle::NAMES.join(", ")
-                    ),
-                ));
-            }
+        if let super::MeshSource::Generated(name) = &o.mesh
+            && !super::obstacle::NAMES.contains(&name.as_str())
+        {
+            return Err(Error::invalid(
+                format!("obstacles[{i}].generated"),
+                format!("`{name}`"),
+                &format!(
+                    "must name a generated mesh ({})",
+                    super::obstacle::NAMES.join(", ")
+                ),
+            ));
         }
         o.transform.validate().map_err(|e| match e {
             Error::InvalidArgument { field, message } => Error::InvalidArgument {

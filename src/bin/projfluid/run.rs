@@ -232,14 +232,14 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         if world.steps() % every == 0 {
             frames.write(world)?;
         }
-        if let Some(n) = args.checkpoint_every {
-            if world.steps() % n == 0 {
-                let path = args
-                    .checkpoint_dir
-                    .join(format!("checkpoint_{:06}.pfck", world.steps()));
-                write_checkpoint(&path, &scene, world, Some(run_end))
-                    .map_err(|e| Failure::Runtime(e.to_string()))?;
-            }
+        if let Some(n) = args.checkpoint_every
+            && world.steps() % n == 0
+        {
+            let path = args
+                .checkpoint_dir
+                .join(format!("checkpoint_{:06}.pfck", world.steps()));
+            write_checkpoint(&path, &scene, world, Some(run_end))
+                .map_err(|e| Failure::Runtime(e.to_string()))?;
         }
         progress.update(report);
         Ok(())

@@ -395,24 +395,50 @@ impl Block<'_> {
     /// portable and the AVX2 build.
     #[inline(always)]
     fn search_portable(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
-        self.search_with::<false>(queries, counts, found)
+        self.search_with::<false, false>(queries, counts, found)
     }
 
-    /// The AVX-512 build of [`Block::search`].
+    /// The AVX-512 build of [`Block::search`]. A point set searched among itself (a
+    /// fluid's) yields a neighbour in about one candidate of seven; a search among another
+    /// set (a boundary's wall points, which crowd the cells next to the fluid) in about one
+    /// of sixty, and skips candidates by groups ([`push_within_avx512`]).
     ///
     /// # Safety
-    /// The processor must support AVX-512 F, VL, DQ and BW ([`crate::simd::has_avx512`]).
+    /// The processor must support what [`crate::simd::has_avx512`] checks.
     #[cfg(target_arch = "x86_64")]
-    #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw")]
     unsafe fn search_avx512(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
-        self.search_with::<true>(queries, counts, found)
+        // SAFETY: as this function's.
+        unsafe {
+            if self.exclude_self.is_some() {
+                self.search_avx512_with::<false>(queries, counts, found)
+            } else {
+                self.search_avx512_with::<true>(queries, counts, found)
+            }
+        }
+    }
+
+    /// [`Block::search_avx512`] for one kind of search, compiled on its own.
+    ///
+    /// # Safety
+    /// The processor must support what [`crate::simd::has_avx512`] checks.
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw,popcnt")]
+    #[inline(never)]
+    unsafe fn search_avx512_with<const SPARSE: bool>(
+        &self,
+        queries: &[Vec3],
+        counts: &mut Vec<u32>,
+        found: &mut Vec<u32>,
+    ) {
+        self.search_with::<true, SPARSE>(queries, counts, found)
     }
 
     /// The body of [`Block::search`]; with `AVX512` the distance tests run eight lanes wide
     /// and the neighbours found are compressed into `found` a vector at a time (only
-    /// instantiated so by [`Block::search_avx512`]).
+    /// instantiated so by [`Block::search_avx512`]), skipping candidates by groups with
+    /// `SPARSE` ([`push_within_avx512`]).
     #[inline(always)]
-    fn search_with<const AVX512: bool>(
+    fn search_with<const AVX512: bool, const SPARSE: bool>(
         &self,
         queries: &[Vec3],
         counts: &mut Vec<u32>,
@@ -462,8 +488,9 @@ impl Block<'_> {
             if AVX512 {
                 // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
                 // processor has AVX-512; `ids` and `candidates` are equally long.
-                unsafe { push_within_avx512(q, &candidates, &ids, own, self.r2, found) };
-                counts.push((found.len() - start) as u32);
+                unsafe { push_within_avx512::<SPARSE>(q, &candidates, &ids, own, self.r2, found) };
+                let kept = found.len() - start;
+                counts.push(kept as u32);
                 continue;
             }
             push_within_portable(q, &candidates, &ids, own, self.r2, found);
@@ -510,18 +537,21 @@ fn push_within_portable(
 }
 
 /// [`push_within_portable`] eight candidates at a time: the same operations in the same
-/// order (so the same tests, bit for bit), a mask compare, and the ids that pass compressed
-/// to the front of a vector that is stored whole at the end of `found` (room for it is
-/// reserved; the entries past the ids kept are overwritten by the next store or left
-/// beyond the length).
+/// order (so the same tests, bit for bit) into a mask, and the ids that pass compressed to
+/// the front of a vector that is stored whole at the end of `found` (room for one more
+/// vector is reserved; the entries past the ids kept are overwritten by the next store or
+/// left beyond the length). With `SPARSE` the masks of four batches are formed first and
+/// a group of 32 candidates none of which passes is skipped: worth its branch where few
+/// candidates pass (about one in sixty of the boundary's), not where one in seven does
+/// (the fluid's); see [`Block::search_avx512`].
 ///
 /// # Safety
-/// The processor must support AVX-512 F and VL; `candidates` holds at least `ids.len()`
-/// points.
+/// The processor must support what [`crate::simd::has_avx512`] checks; `candidates` holds
+/// at least `ids.len()` points.
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw")]
+#[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw,popcnt")]
 #[inline]
-unsafe fn push_within_avx512(
+unsafe fn push_within_avx512<const SPARSE: bool>(
     q: &Vec3,
     candidates: &PointsByComponent,
     ids: &[u32],
@@ -547,34 +577,52 @@ unsafe fn push_within_avx512(
         candidates.y.as_ptr(),
         candidates.z.as_ptr(),
     );
-    let mut lo = 0;
-    while lo < n {
-        let rest = n - lo;
-        let lanes: __mmask8 = if rest >= WIDTH {
+    // The lanes of the batch at `at` that hold candidates (all but in the last batch).
+    let lanes = |at: usize| -> __mmask8 {
+        let rest = n - at;
+        if rest >= WIDTH {
             0xff
         } else {
             (1u8 << rest) - 1
-        };
-        // SAFETY: masked loads read only lanes below `n`, within the arrays; the store
-        // writes `WIDTH` ids at `len` ≤ the old length + `lo`, within the reserved room.
-        unsafe {
-            let dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, x.add(lo)), qx);
-            let dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, y.add(lo)), qy);
-            let dz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, z.add(lo)), qz);
-            let d2 = _mm512_add_pd(
-                _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-                _mm512_mul_pd(dz, dz),
-            );
-            let mut within = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(lanes, d2, r2);
-            if let Some(own) = own.filter(|own| (lo..lo + WIDTH).contains(own)) {
-                within &= !(1u8 << (own - lo));
-            }
-            let batch = _mm256_maskz_loadu_epi32(lanes, ids.as_ptr().add(lo).cast());
-            let kept = _mm256_maskz_compress_epi32(within, batch);
-            _mm256_storeu_si256(out.add(len).cast(), kept);
-            len += within.count_ones() as usize;
         }
-        lo += WIDTH;
+    };
+    // SAFETY: masked loads read only lanes below `n`, within the arrays.
+    let within = |at: usize| unsafe {
+        let lanes = lanes(at);
+        let dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, x.add(at)), qx);
+        let dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, y.add(at)), qy);
+        let dz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, z.add(at)), qz);
+        let d2 = _mm512_add_pd(
+            _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+            _mm512_mul_pd(dz, dz),
+        );
+        let mut within = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(lanes, d2, r2);
+        if let Some(own) = own.filter(|own| (at..at + WIDTH).contains(own)) {
+            within &= !(1u8 << (own - at));
+        }
+        within
+    };
+    // SAFETY: the masked load reads only lanes below `n`; the store writes `WIDTH` ids at
+    // `len` ≤ the old length + `at`, within the reserved room.
+    let mut store = |at: usize, kept: __mmask8| unsafe {
+        let batch = _mm256_maskz_loadu_epi32(lanes(at), ids.as_ptr().add(at).cast());
+        let packed = _mm256_maskz_compress_epi32(kept, batch);
+        _mm256_storeu_si256(out.add(len).cast(), packed);
+        len += kept.count_ones() as usize;
+    };
+    if SPARSE {
+        const GROUP: usize = 4 * WIDTH;
+        for lo in (0..n).step_by(GROUP) {
+            let batches = (lo..(lo + GROUP).min(n)).step_by(WIDTH);
+            if batches.clone().all(|at| within(at) == 0) {
+                continue;
+            }
+            batches.for_each(|at| store(at, within(at)));
+        }
+    } else {
+        for at in (0..n).step_by(WIDTH) {
+            store(at, within(at));
+        }
     }
     // SAFETY: the first `len` entries are initialised (the old ones, then the kept ids).
     unsafe { found.set_len(len) };

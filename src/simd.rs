@@ -42,12 +42,13 @@ macro_rules! avx2_dispatch {
 
 pub(crate) use avx2_dispatch;
 
-/// Whether the processor supports the AVX-512 subsets (F, VL, DQ, BW) the AVX-512 builds
-/// are compiled for.
+/// Whether the processor supports what the AVX-512 builds are compiled for: the AVX-512
+/// subsets F, VL, DQ and BW, and POPCNT.
 #[cfg(target_arch = "x86_64")]
 #[inline]
 pub(crate) fn has_avx512() -> bool {
     std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("popcnt")
         && std::arch::is_x86_feature_detected!("avx512vl")
         && std::arch::is_x86_feature_detected!("avx512dq")
         && std::arch::is_x86_feature_detected!("avx512bw")

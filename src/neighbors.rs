@@ -433,10 +433,11 @@ impl Block<'_> {
         self.search_with::<true, SPARSE>(queries, counts, found)
     }
 
-    /// The body of [`Block::search`]; with `AVX512` the distance tests run eight lanes wide
-    /// and the neighbours found are compressed into `found` a vector at a time (only
-    /// instantiated so by [`Block::search_avx512`]), skipping candidates by groups with
-    /// `SPARSE` ([`push_within_avx512`]).
+    /// The body of [`Block::search`]. With `AVX512` (only instantiated so by
+    /// [`Block::search_avx512`]) the candidates are tested where they lie, eight lanes wide,
+    /// and the neighbours found are compressed into `found` a vector at a time, skipping
+    /// candidates by groups with `SPARSE` ([`push_within_avx512`]); without, they are first
+    /// copied into one run.
     #[inline(always)]
     fn search_with<const AVX512: bool, const SPARSE: bool>(
         &self,
@@ -448,9 +449,10 @@ impl Block<'_> {
         let p = self.points;
         counts.clear();
         found.clear();
-        // The points of the previous query's cell and its neighbour cells, copied in
-        // ascending Z-rank of the cells (so their indices ascend and no list needs
-        // sorting) into one run that every query of the cell tests in long loops.
+        // The points of the previous query's cell and its neighbour cells, in ascending
+        // Z-rank of the cells (so their indices ascend and no list needs sorting): the
+        // ranges of the cells, and (without `AVX512`) their points copied into one run that
+        // every query of the cell tests in long loops.
         let mut cached: Option<[usize; 3]> = None;
         let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
         // The thread's buffers for that run, kept from block to block (they only grow).
@@ -475,24 +477,35 @@ impl Block<'_> {
                     }
                 }
                 ranges.sort_unstable_by_key(|r| r.start);
-                candidates.copy_ranges(p, &ranges);
-                ids.clear();
-                for r in &ranges {
-                    ids.extend(r.start as u32..r.end as u32);
+                if AVX512 {
+                    // Tested where they lie: cells adjacent in Z-order make one run.
+                    ranges.dedup_by(|next, run| {
+                        let adjacent = run.end == next.start;
+                        if adjacent {
+                            run.end = next.end;
+                        }
+                        adjacent
+                    });
+                } else {
+                    candidates.copy_ranges(p, &ranges);
+                    ids.clear();
+                    for r in &ranges {
+                        ids.extend(r.start as u32..r.end as u32);
+                    }
                 }
+            }
+            #[cfg(target_arch = "x86_64")]
+            if AVX512 {
+                let own = self.exclude_self.map(|first| first + k);
+                // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
+                // processor has AVX-512; the ranges lie within the table's points.
+                unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
+                counts.push((found.len() - start) as u32);
+                continue;
             }
             let own = self
                 .exclude_self
                 .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
-            #[cfg(target_arch = "x86_64")]
-            if AVX512 {
-                // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
-                // processor has AVX-512; `ids` and `candidates` are equally long.
-                unsafe { push_within_avx512::<SPARSE>(q, &candidates, &ids, own, self.r2, found) };
-                let kept = found.len() - start;
-                counts.push(kept as u32);
-                continue;
-            }
             push_within_portable(q, &candidates, &ids, own, self.r2, found);
             counts.push((found.len() - start) as u32);
         }
@@ -536,34 +549,35 @@ fn push_within_portable(
     }
 }
 
-/// [`push_within_portable`] eight candidates at a time: the same operations in the same
-/// order (so the same tests, bit for bit) into a mask, and the ids that pass compressed to
-/// the front of a vector that is stored whole at the end of `found` (room for one more
-/// vector is reserved; the entries past the ids kept are overwritten by the next store or
-/// left beyond the length). With `SPARSE` the masks of four batches are formed first and
-/// a group of 32 candidates none of which passes is skipped: worth its branch where few
-/// candidates pass (about one in sixty of the boundary's), not where one in seven does
-/// (the fluid's); see [`Block::search_avx512`].
+/// [`push_within_portable`] for the points of `ranges` of `points` (ascending and
+/// disjoint), tested where they lie, eight at a time: the same operations in the same
+/// order (so the same tests, bit for bit) into a mask, and the indices that pass
+/// compressed to the front of a vector that is stored whole at the end of `found` (room for
+/// one more vector is reserved; the entries past the indices kept are overwritten by the
+/// next store or left beyond the length). Point `own` is left out. With `SPARSE` the masks
+/// of four batches are formed first and a group of 32 points none of which passes is
+/// skipped: worth its branch where few candidates pass (about one in sixty of the
+/// boundary's), not where one in seven does (the fluid's); see [`Block::search_avx512`].
 ///
 /// # Safety
-/// The processor must support what [`crate::simd::has_avx512`] checks; `candidates` holds
-/// at least `ids.len()` points.
+/// The processor must support what [`crate::simd::has_avx512`] checks; the ranges lie
+/// within `points`, whose indices fit in `u32`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,avx512f,avx512vl,avx512dq,avx512bw,popcnt")]
 #[inline]
 unsafe fn push_within_avx512<const SPARSE: bool>(
     q: &Vec3,
-    candidates: &PointsByComponent,
-    ids: &[u32],
+    points: &PointsByComponent,
+    ranges: &[std::ops::Range<usize>],
     own: Option<usize>,
     r2: f64,
     found: &mut Vec<u32>,
 ) {
     use std::arch::x86_64::*;
     const WIDTH: usize = 8;
-    let n = ids.len();
-    debug_assert!(candidates.x.len() >= n && candidates.y.len() >= n && candidates.z.len() >= n);
-    found.reserve(n + WIDTH);
+    let total: usize = ranges.iter().map(|r| r.len()).sum();
+    debug_assert!(ranges.iter().all(|r| r.end <= points.x.len()));
+    found.reserve(total + WIDTH);
     let mut len = found.len();
     let out = found.as_mut_ptr();
     let (qx, qy, qz) = (
@@ -572,56 +586,56 @@ unsafe fn push_within_avx512<const SPARSE: bool>(
         _mm512_set1_pd(q.z),
     );
     let r2 = _mm512_set1_pd(r2);
-    let (x, y, z) = (
-        candidates.x.as_ptr(),
-        candidates.y.as_ptr(),
-        candidates.z.as_ptr(),
-    );
-    // The lanes of the batch at `at` that hold candidates (all but in the last batch).
-    let lanes = |at: usize| -> __mmask8 {
-        let rest = n - at;
-        if rest >= WIDTH {
-            0xff
-        } else {
-            (1u8 << rest) - 1
-        }
-    };
-    // SAFETY: masked loads read only lanes below `n`, within the arrays.
-    let within = |at: usize| unsafe {
-        let lanes = lanes(at);
-        let dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, x.add(at)), qx);
-        let dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, y.add(at)), qy);
-        let dz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, z.add(at)), qz);
-        let d2 = _mm512_add_pd(
-            _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
-            _mm512_mul_pd(dz, dz),
-        );
-        let mut within = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(lanes, d2, r2);
-        if let Some(own) = own.filter(|own| (at..at + WIDTH).contains(own)) {
-            within &= !(1u8 << (own - at));
-        }
-        within
-    };
-    // SAFETY: the masked load reads only lanes below `n`; the store writes `WIDTH` ids at
-    // `len` ≤ the old length + `at`, within the reserved room.
-    let mut store = |at: usize, kept: __mmask8| unsafe {
-        let batch = _mm256_maskz_loadu_epi32(lanes(at), ids.as_ptr().add(at).cast());
-        let packed = _mm256_maskz_compress_epi32(kept, batch);
-        _mm256_storeu_si256(out.add(len).cast(), packed);
-        len += kept.count_ones() as usize;
-    };
-    if SPARSE {
-        const GROUP: usize = 4 * WIDTH;
-        for lo in (0..n).step_by(GROUP) {
-            let batches = (lo..(lo + GROUP).min(n)).step_by(WIDTH);
-            if batches.clone().all(|at| within(at) == 0) {
-                continue;
+    let (x, y, z) = (points.x.as_ptr(), points.y.as_ptr(), points.z.as_ptr());
+    let lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+    for range in ranges {
+        let end = range.end;
+        // The lanes of the batch at `at` that hold points of the range.
+        let lanes = |at: usize| -> __mmask8 {
+            let rest = end - at;
+            if rest >= WIDTH {
+                0xff
+            } else {
+                (1u8 << rest) - 1
             }
-            batches.for_each(|at| store(at, within(at)));
-        }
-    } else {
-        for at in (0..n).step_by(WIDTH) {
-            store(at, within(at));
+        };
+        // SAFETY: masked loads read only lanes below the range's end, within the arrays.
+        let within = |at: usize| unsafe {
+            let lanes = lanes(at);
+            let dx = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, x.add(at)), qx);
+            let dy = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, y.add(at)), qy);
+            let dz = _mm512_sub_pd(_mm512_maskz_loadu_pd(lanes, z.add(at)), qz);
+            let d2 = _mm512_add_pd(
+                _mm512_add_pd(_mm512_mul_pd(dx, dx), _mm512_mul_pd(dy, dy)),
+                _mm512_mul_pd(dz, dz),
+            );
+            let mut within = _mm512_mask_cmp_pd_mask::<_CMP_LE_OQ>(lanes, d2, r2);
+            if let Some(own) = own.filter(|own| (at..at + WIDTH).contains(own)) {
+                within &= !(1u8 << (own - at));
+            }
+            within
+        };
+        // SAFETY: the store writes `WIDTH` indices at `len` ≤ the old length + the points
+        // tested so far, within the reserved room.
+        let mut store = |at: usize, kept: __mmask8| unsafe {
+            let indices = _mm256_add_epi32(_mm256_set1_epi32(at as i32), lane);
+            let packed = _mm256_maskz_compress_epi32(kept, indices);
+            _mm256_storeu_si256(out.add(len).cast(), packed);
+            len += kept.count_ones() as usize;
+        };
+        if SPARSE {
+            const GROUP: usize = 4 * WIDTH;
+            for lo in range.clone().step_by(GROUP) {
+                let batches = (lo..(lo + GROUP).min(end)).step_by(WIDTH);
+                if batches.clone().all(|at| within(at) == 0) {
+                    continue;
+                }
+                batches.for_each(|at| store(at, within(at)));
+            }
+        } else {
+            for at in range.clone().step_by(WIDTH) {
+                store(at, within(at));
+            }
         }
     }
     // SAFETY: the first `len` entries are initialised (the old ones, then the kept ids).

@@ -802,17 +802,16 @@ impl DensityConstraint {
             gather.ids[active] = i;
             active += usize::from(corrections.moved[i as usize]);
         }
-        for (lambda, &i) in gather.lambdas[..active].iter_mut().zip(&gather.ids) {
-            *lambda = corrections.lambdas[i as usize];
-        }
         let g = gather;
         let xj = x[j];
-        for (((&i, rx), ry), rz) in g.ids[..active]
+        for ((((&i, lambda), rx), ry), rz) in g.ids[..active]
             .iter()
+            .zip(&mut g.lambdas)
             .zip(&mut g.rx)
             .zip(&mut g.ry)
             .zip(&mut g.rz)
         {
+            *lambda = corrections.lambdas[i as usize];
             let xi = &x[i as usize];
             (*rx, *ry, *rz) = (xj.x - xi.x, xj.y - xi.y, xj.z - xi.z);
         }

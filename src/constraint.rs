@@ -781,9 +781,9 @@ impl DensityConstraint {
 
     /// The body of [`Self::gathered_corrections`]. A first pass lists, without branches and
     /// from one byte per particle, the neighbours i whose single-step projection moved j
-    /// (λ_i ≠ 0; about a quarter of them in a flow, in no predictable order); a second
-    /// evaluates their λ_i∇W(x_j − x_i) by component, four at a time. Kept segments are read
-    /// apart (rare).
+    /// (λ_i ≠ 0; about a quarter of them in a flow, in no predictable order); a second reads
+    /// their λ_i and offsets, and a third evaluates their λ_i∇W(x_j − x_i) by component, four
+    /// at a time. Kept segments are read apart (rare).
     #[inline(always)]
     fn gathered_correction_portable(
         &self,

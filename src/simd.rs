@@ -1,4 +1,4 @@
-//! Run-time choice of an AVX2 build of a hot method.
+//! Run-time choice of an AVX2 (or AVX-512) build of a hot method.
 //!
 //! The hot loops (a constraint's projection, the global step's gather, a block of
 //! neighbour queries) are written once, as `#[inline(always)]` portable methods whose loops
@@ -6,6 +6,10 @@
 //! with AVX2 enabled, so that those loops run four lanes wide, and picks the build at run
 //! time. Without fused multiply-adds both builds perform the same IEEE operations in the
 //! same order, so their results are bitwise the same (tested for each use).
+//!
+//! The neighbour search also has an AVX-512 build, written with explicit intrinsics (mask
+//! compares and compress stores) rather than by recompiling the portable loops; it runs
+//! where [`has_avx512`] holds.
 
 /// Defines `$name`, which calls the `#[inline(always)]` method `$portable` with the same
 /// arguments, compiled for AVX2 (as the private method `$avx2`) where the processor has AVX2

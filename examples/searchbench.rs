@@ -62,8 +62,8 @@ fn main() {
             });
             println!(
                 "round {round}: fluid {among_fluid:.3} ms ({} pairs), boundary {among_boundary:.3} ms ({} pairs)",
-                fluid_lists.indices.len(),
-                boundary_lists.indices.len()
+                fluid_lists.pairs(),
+                boundary_lists.pairs()
             );
         }
     });

@@ -3,7 +3,7 @@
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;
-use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
+use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 use rayon::prelude::*;
 
 pub mod mesh;
@@ -84,33 +84,47 @@ pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Ve
 }
 
 /// Akinci volumes V_b = 1/Σ_{b'} W(x_b − x_b') (self included) for boundary particles
-/// `points` sorted by `table` on `grid`, in m³.
+/// `points` sorted by `table` on `grid` (`by_component`: the same points by component), in
+/// m³. The neighbours are searched [`VOLUME_BATCH`] particles at a time, so that only one
+/// batch's lists are held (a whole boundary's were once the largest allocation of a world).
 pub fn akinci_volumes(
     grid: &UniformGrid,
     table: &CellTable,
     points: &[Vec3],
+    by_component: &PointsByComponent,
     kernel: &CubicKernel,
 ) -> Vec<f64> {
+    volumes_in_batches(grid, table, points, by_component, kernel, VOLUME_BATCH)
+}
+
+/// How many boundary particles [`akinci_volumes`] searches at a time.
+const VOLUME_BATCH: usize = 1 << 14;
+
+/// [`akinci_volumes`], searching `batch` particles at a time.
+fn volumes_in_batches(
+    grid: &UniformGrid,
+    table: &CellTable,
+    points: &[Vec3],
+    by_component: &PointsByComponent,
+    kernel: &CubicKernel,
+    batch: usize,
+) -> Vec<f64> {
     let mut lists = NeighborLists::default();
-    grid.search(
-        table,
-        points,
-        points,
-        kernel.support_radius(),
-        true,
-        &mut lists,
-    );
-    (0..points.len())
-        .into_par_iter()
-        .map(|b| {
+    let mut volumes = Vec::with_capacity(points.len());
+    let h = kernel.support_radius();
+    for first in (0..points.len()).step_by(batch) {
+        let queries = &points[first..first.saturating_add(batch).min(points.len())];
+        grid.search_from(table, by_component, queries, Some(first), h, &mut lists);
+        volumes.par_extend(queries.par_iter().enumerate().map(|(k, x)| {
             let sum: f64 = lists
-                .of(b)
+                .of(k)
                 .iter()
-                .map(|&c| kernel.w((points[b] - points[c as usize]).norm()))
+                .map(|&c| kernel.w((x - points[c as usize]).norm()))
                 .sum();
             1.0 / (kernel.w_zero() + sum)
-        })
-        .collect()
+        }));
+    }
+    volumes
 }
 
 #[cfg(test)]
@@ -162,7 +176,9 @@ mod tests {
         let mut order = Vec::new();
         grid.sort(&pts, &mut order, &mut table);
         let sorted: Vec<Vec3> = order.iter().map(|&i| pts[i as usize]).collect();
-        let volumes = akinci_volumes(&grid, &table, &sorted, &kernel);
+        let mut by_component = PointsByComponent::default();
+        by_component.fill(&sorted);
+        let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, &kernel);
         let centre = sorted
             .iter()
             .position(|p| (p - Vec3::new(0.5, 0.0, 0.5)).norm() < 1e-9)
@@ -175,5 +191,13 @@ mod tests {
         // A corner particle has fewer neighbours, hence a larger volume.
         let corner = sorted.iter().position(|p| p.norm() < 1e-9).unwrap();
         assert!(volumes[corner] > 2.0 * volumes[centre]);
+        // Searched in batches of any size (one point, a few, or more than a cell's), every
+        // volume comes out bit for bit as from one search of all points.
+        let whole = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, usize::MAX);
+        assert_eq!(volumes, whole);
+        for batch in [1, 7, 100, 1000] {
+            let parts = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, batch);
+            assert_eq!(parts, whole, "batches of {batch}");
+        }
     }
 }

@@ -152,14 +152,15 @@ impl UniformGrid {
         }
         order.clear();
         order.resize(points.len(), 0);
-        let cursor = &mut table.cursor;
-        cursor.clear();
-        cursor.extend_from_slice(&starts[..self.cell_count()]);
+        // Each cell's start serves as its cursor, which leaves it at the cell's end, the
+        // next cell's start; shifting by one cell restores the starts.
         for (i, &r) in ranks.iter().enumerate() {
-            let slot = &mut cursor[r as usize];
+            let slot = &mut starts[r as usize];
             order[*slot as usize] = i as u32;
             *slot += 1;
         }
+        starts.copy_within(..self.cell_count(), 1);
+        starts[0] = 0;
         covered
     }
 
@@ -195,6 +196,23 @@ impl UniformGrid {
         exclude_self: bool,
         out: &mut NeighborLists,
     ) {
+        let first = exclude_self.then_some(0);
+        self.search_from(table, points, queries, first, radius, out);
+    }
+
+    /// [`UniformGrid::search_in`] for a run of the points themselves: with `Some(first)` the
+    /// queries are the points `first..first + queries.len()` and each skips itself (so that
+    /// a large set can be searched among itself a part at a time); with `None` no query
+    /// skips anything. List k belongs to query k.
+    pub(crate) fn search_from(
+        &self,
+        table: &CellTable,
+        points: &PointsByComponent,
+        queries: &[Vec3],
+        first_self: Option<usize>,
+        radius: f64,
+        out: &mut NeighborLists,
+    ) {
         assert!(
             radius <= self.cell_size,
             "search radius exceeds the cell size"
@@ -206,8 +224,8 @@ impl UniformGrid {
         );
         let r2 = radius * radius;
         let blocks = queries.len().div_ceil(BLOCK);
-        out.scratch.resize_with(blocks, Default::default);
-        out.scratch
+        out.blocks.resize_with(blocks, Default::default);
+        out.blocks
             .par_iter_mut()
             .enumerate()
             .for_each(|(b, (counts, found))| {
@@ -218,30 +236,19 @@ impl UniformGrid {
                     table,
                     points,
                     r2,
-                    exclude_self: exclude_self.then_some(first),
+                    exclude_self: first_self.map(|own| own + first),
                 };
                 block.search(queries, counts, found);
             });
         out.offsets.clear();
         out.offsets.push(0);
         let mut total = 0u32;
-        for (counts, _) in &out.scratch {
+        for (counts, _) in &out.blocks {
             for &n in counts {
                 total += n;
                 out.offsets.push(total);
             }
         }
-        out.indices.resize(total as usize, 0);
-        let mut rest = out.indices.as_mut_slice();
-        let mut pieces = Vec::with_capacity(blocks);
-        for (_, found) in &out.scratch {
-            let (head, tail) = rest.split_at_mut(found.len());
-            pieces.push((head, found));
-            rest = tail;
-        }
-        pieces
-            .into_par_iter()
-            .for_each(|(dst, src)| dst.copy_from_slice(src));
     }
 }
 
@@ -251,19 +258,18 @@ impl UniformGrid {
 pub struct CellTable {
     cell_start: Vec<u32>,
     ranks: Vec<u32>,
-    /// Scratch of the counting sort: the next free slot of every cell.
-    cursor: Vec<u32>,
 }
 
-/// Neighbour lists in compressed form: the neighbours of query i are
-/// `indices[offsets[i]..offsets[i + 1]]`, ascending.
+/// Neighbour lists in compressed form, kept where the search wrote them: the queries are
+/// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`. The
+/// neighbours of query i are ascending, at `offsets[i]..offsets[i + 1]` counted over all
+/// blocks (so at those minus the block's first offset within its own block).
 #[derive(Clone, Debug, Default)]
 pub struct NeighborLists {
-    /// Start of each query's list in `indices`; one more entry than queries.
-    pub offsets: Vec<u32>,
-    /// Neighbour indices, concatenated.
-    pub indices: Vec<u32>,
-    scratch: Vec<(Vec<u32>, Vec<u32>)>,
+    /// Start of each query's list, counted over all blocks; one more entry than queries.
+    offsets: Vec<u32>,
+    /// Per block of queries: the number of neighbours of each, and their lists concatenated.
+    blocks: Vec<(Vec<u32>, Vec<u32>)>,
     /// The searched points by component, for [`UniformGrid::search`].
     coordinates: PointsByComponent,
 }
@@ -272,7 +278,10 @@ impl NeighborLists {
     /// The neighbours of query `i`.
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {
-        &self.indices[self.offsets[i] as usize..self.offsets[i + 1] as usize]
+        let b = i / BLOCK;
+        let base = self.offsets[b * BLOCK];
+        let (start, end) = (self.offsets[i] - base, self.offsets[i + 1] - base);
+        &self.blocks[b].1[start as usize..end as usize]
     }
 
     /// The number of neighbours of query `i`.
@@ -289,6 +298,11 @@ impl NeighborLists {
     /// True when there are no queries.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The number of neighbours of all queries together (pairs found).
+    pub fn pairs(&self) -> usize {
+        self.offsets.last().map_or(0, |&n| n as usize)
     }
 }
 
@@ -851,7 +865,8 @@ mod tests {
                 let sorted = sorted_copy(&grid, &pts, &mut table);
                 let mut lists = NeighborLists::default();
                 grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
-                (lists.offsets, lists.indices)
+                let all: Vec<Vec<u32>> = (0..lists.len()).map(|i| lists.of(i).to_vec()).collect();
+                all
             })
         };
         assert_eq!(run(1), run(3));

@@ -20,7 +20,8 @@ pub(crate) struct StepBuffers {
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,
-    /// Right-hand side b of the global step (kg·m).
+    /// Right-hand side b of the global step (kg·m), for the solvers that are not one
+    /// Jacobi sweep (the sweep's is formed a chunk at a time).
     rhs: Vec<Vec3>,
     /// Local-step results per constraint.
     projections: Vec<Projection>,
@@ -35,7 +36,6 @@ pub(crate) struct StepBuffers {
     system: DiagonalSystem,
     /// The volume m/ρ_j of every fluid particle after the step, for XSPH (m³).
     volumes: Vec<f64>,
-    scratch: Vec<Vec3>,
     scratch_ids: Vec<u32>,
     /// δ_k of every outer iteration of the last step (m).
     pub(crate) displacements: Vec<f64>,
@@ -180,9 +180,9 @@ impl World {
         let stats = pool.install(|| {
             let b = &mut buffers;
             // Reorder all per-particle arrays, then search on s.
-            permute(&b.order, &mut fluid.positions, &mut b.scratch);
-            permute(&b.order, &mut fluid.velocities, &mut b.scratch);
-            permute(&b.order, &mut b.predicted, &mut b.scratch);
+            permute(&b.order, &mut fluid.positions, &mut b.next);
+            permute(&b.order, &mut fluid.velocities, &mut b.next);
+            permute(&b.order, &mut b.predicted, &mut b.next);
             permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
             let h = params.support_radius();
             grid.search(
@@ -219,7 +219,6 @@ impl World {
             b.current.clone_from(&b.predicted);
             b.previous.clone_from(&b.predicted);
             b.next.resize(b.predicted.len(), Vec3::zeros());
-            b.rhs.resize(b.predicted.len(), Vec3::zeros());
             constraint.weights(&b.fluid_lists, &mut b.weights);
             let nb = Neighborhood {
                 fluid: &b.fluid_lists,
@@ -269,18 +268,21 @@ impl World {
                         chebyshev: (accelerate && chebyshev.changes(omega))
                             .then_some((&*chebyshev, omega)),
                     };
+                    // The right-hand side lives only as long as its chunk's sweep.
                     displacement = b
-                        .rhs
+                        .next
                         .par_chunks_mut(CHUNK)
-                        .zip(b.next.par_chunks_mut(CHUNK))
                         .enumerate()
-                        .map(|(chunk, (rhs, next))| {
+                        .map(|(chunk, next)| {
+                            let mut rhs = [Vec3::zeros(); CHUNK];
+                            let rhs = &mut rhs[..next.len()];
                             fill_rhs(chunk, rhs);
                             sweep.apply(chunk * CHUNK, rhs, next)
                         })
                         .reduce(|| f64::NEG_INFINITY, reduce::nan_max);
                     inner += 1;
                 } else {
+                    b.rhs.resize(b.predicted.len(), Vec3::zeros());
                     b.rhs
                         .par_chunks_mut(CHUNK)
                         .enumerate()
@@ -324,7 +326,7 @@ impl World {
             // 6. Densities at the new positions (step's neighbour lists), 7. XSPH.
             constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
             if params.viscosity > 0.0 {
-                let buffers = (&mut b.volumes, &mut b.scratch);
+                let buffers = (&mut b.volumes, &mut b.next);
                 xsph(params.viscosity, constraint, &nb, fluid, buffers);
             }
             let rest = constraint.rest_density;

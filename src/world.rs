@@ -423,8 +423,14 @@ impl World {
     pub fn positions_hash(&self) -> String {
         use sha2::{Digest, Sha256};
         let mut hasher = Sha256::new();
-        for p in self.positions() {
-            for c in p.iter() {
+        // The particles' slots in the order they were added (a quarter of a copy of the
+        // positions).
+        let mut slots = vec![0u32; self.fluid_count()];
+        for (slot, &id) in self.fluid.ids.iter().enumerate() {
+            slots[id as usize] = slot as u32;
+        }
+        for &slot in &slots {
+            for c in self.fluid.positions[slot as usize].iter() {
                 hasher.update(c.to_bits().to_le_bytes());
             }
         }
@@ -479,7 +485,8 @@ impl World {
             grid.sort(&b.positions, &mut order, &mut b.table);
             b.positions = order.iter().map(|&i| b.positions[i as usize]).collect();
             b.by_component.fill(&b.positions);
-            let volumes = akinci_volumes(grid, &b.table, &b.positions, &self.constraint.kernel);
+            let kernel = &self.constraint.kernel;
+            let volumes = akinci_volumes(grid, &b.table, &b.positions, &b.by_component, kernel);
             b.psi = volumes
                 .iter()
                 .map(|v| v * self.params.rest_density)

@@ -219,7 +219,7 @@ impl UniformGrid {
         );
         assert_eq!(
             points.x.len(),
-            table.ranks.len(),
+            table.point_count(),
             "search: not the points the table sorted"
         );
         let r2 = radius * radius;
@@ -257,7 +257,20 @@ impl UniformGrid {
 #[derive(Clone, Debug, Default)]
 pub struct CellTable {
     cell_start: Vec<u32>,
+    /// Scratch of the sort: the cell of every point.
     ranks: Vec<u32>,
+}
+
+impl CellTable {
+    /// The number of points sorted.
+    fn point_count(&self) -> usize {
+        self.cell_start.last().map_or(0, |&n| n as usize)
+    }
+
+    /// Frees the sort's scratch, for a table that is sorted once and kept (the boundary's).
+    pub(crate) fn release_scratch(&mut self) {
+        self.ranks = Vec::new();
+    }
 }
 
 /// Neighbour lists in compressed form, kept where the search wrote them: the queries are
@@ -298,6 +311,12 @@ impl NeighborLists {
     /// True when there are no queries.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
+    }
+
+    /// The points searched by the last [`UniformGrid::search`] into these lists, by
+    /// component (m).
+    pub fn searched_points(&self) -> &PointsByComponent {
+        &self.coordinates
     }
 
     /// The number of neighbours of all queries together (pairs found).
@@ -358,6 +377,22 @@ impl PointsByComponent {
                 out.extend_from_slice(&from[range.clone()]);
             }
         }
+    }
+
+    /// Point `i` (m).
+    #[inline]
+    pub fn at(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    /// The number of points.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
     }
 
     /// Replaces the contents with `points` (m), in one parallel pass.

@@ -14,8 +14,6 @@ use std::time::Instant;
 /// Buffers reused by every step, so that a step allocates nothing once sizes are stable.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct StepBuffers {
-    /// Inertial prediction s (m).
-    predicted: Vec<Vec3>,
     /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m).
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
@@ -140,28 +138,27 @@ impl World {
         let started = Instant::now();
         let gravity = Vec3::from(self.params.gravity);
         let mut buffers = std::mem::take(&mut self.buffers);
-        // 1. Inertial prediction s = x + Δt v + Δt² g.
+        // 1. Inertial prediction s = x + Δt v + Δt² g, into the buffer of X^(k) (it is
+        // X^(0)); the search keeps a copy by component, which serves where s is read later.
         let fluid = &self.fluid;
         self.pool.install(|| {
+            buffers.current.resize(fluid.positions.len(), Vec3::zeros());
             buffers
-                .predicted
-                .resize(fluid.positions.len(), Vec3::zeros());
-            buffers
-                .predicted
+                .current
                 .par_iter_mut()
                 .zip(fluid.positions.par_iter().zip(fluid.velocities.par_iter()))
                 .for_each(|(s, (x, v))| *s = x + v * dt + gravity * (dt * dt));
         });
         // 2. Sort into Z-order; the sort's pass also tells whether the grid still covers s.
-        self.prepare_grid(&buffers.predicted, false);
+        self.prepare_grid(&buffers.current, false);
         let sort = |world: &World, b: &mut StepBuffers| {
             let grid = world.grid.as_ref().expect("prepare_grid builds the grid");
             world
                 .pool
-                .install(|| grid.sort(&b.predicted, &mut b.order, &mut b.table))
+                .install(|| grid.sort(&b.current, &mut b.order, &mut b.table))
         };
         if !sort(self, &mut buffers) && !self.grid_capped {
-            self.prepare_grid(&buffers.predicted, true);
+            self.prepare_grid(&buffers.current, true);
             sort(self, &mut buffers);
         }
         let mut timings = StepTimings::default();
@@ -182,13 +179,13 @@ impl World {
             // Reorder all per-particle arrays, then search on s.
             permute(&b.order, &mut fluid.positions, &mut b.next);
             permute(&b.order, &mut fluid.velocities, &mut b.next);
-            permute(&b.order, &mut b.predicted, &mut b.next);
+            permute(&b.order, &mut b.current, &mut b.next);
             permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
             let h = params.support_radius();
             grid.search(
                 &b.table,
-                &b.predicted,
-                &b.predicted,
+                &b.current,
+                &b.current,
                 h,
                 true,
                 &mut b.fluid_lists,
@@ -196,7 +193,7 @@ impl World {
             grid.search_in(
                 &boundary.table,
                 &boundary.by_component,
-                &b.predicted,
+                &b.current,
                 h,
                 false,
                 &mut b.boundary_lists,
@@ -216,9 +213,8 @@ impl World {
             solver.prepare(&b.system);
 
             // 4. Outer local/global iterations from X^(0) = X^(−1) = s.
-            b.current.clone_from(&b.predicted);
-            b.previous.clone_from(&b.predicted);
-            b.next.resize(b.predicted.len(), Vec3::zeros());
+            b.previous.clone_from(&b.current);
+            b.next.resize(b.current.len(), Vec3::zeros());
             constraint.weights(&b.fluid_lists, &mut b.weights);
             let nb = Neighborhood {
                 fluid: &b.fluid_lists,
@@ -237,7 +233,7 @@ impl World {
                 constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
                 let t_local = t.elapsed().as_secs_f64();
                 let (projections, corrections) = (&b.projections, &b.corrections);
-                let (current, predicted) = (&b.current, &b.predicted);
+                let (current, predicted) = (&b.current, b.fluid_lists.searched_points());
                 // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
                 // for the particles of chunk `chunk`.
                 let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {
@@ -252,7 +248,7 @@ impl World {
                     );
                     for (j, rhs) in (first..).zip(rhs) {
                         let members = constraint.membership(lists, j);
-                        *rhs = predicted[j] * mass + (current[j] * members + *rhs) * dt2k;
+                        *rhs = predicted.at(j) * mass + (current[j] * members + *rhs) * dt2k;
                     }
                 };
                 if single_sweep {
@@ -282,7 +278,7 @@ impl World {
                         .reduce(|| f64::NEG_INFINITY, reduce::nan_max);
                     inner += 1;
                 } else {
-                    b.rhs.resize(b.predicted.len(), Vec3::zeros());
+                    b.rhs.resize(b.current.len(), Vec3::zeros());
                     b.rhs
                         .par_chunks_mut(CHUNK)
                         .enumerate()
@@ -523,7 +519,9 @@ mod tests {
         for _ in 0..40 {
             world.step().unwrap();
             let grid = world.grid.as_ref().unwrap();
-            assert!(grid.covers(&world.buffers.predicted));
+            let s = world.buffers.fluid_lists.searched_points();
+            let s: Vec<Vec3> = (0..s.len()).map(|i| s.at(i)).collect();
+            assert!(grid.covers(&s));
             first.get_or_insert(grid.parts());
         }
         let x = world.positions()[0].x;

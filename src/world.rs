@@ -483,6 +483,7 @@ impl World {
         let mut order = Vec::new();
         self.pool.install(|| {
             grid.sort(&b.positions, &mut order, &mut b.table);
+            b.table.release_scratch();
             b.positions = order.iter().map(|&i| b.positions[i as usize]).collect();
             b.by_component.fill(&b.positions);
             let kernel = &self.constraint.kernel;

@@ -192,7 +192,7 @@ impl World {
             );
             grid.search_in(
                 &boundary.table,
-                &boundary.by_component,
+                &boundary.positions,
                 &b.current,
                 h,
                 false,

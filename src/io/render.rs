@@ -224,11 +224,10 @@ impl Renderer {
                 c.contains(p, 2.5 * r) && !deep_inside
             })
         };
-        let obstacle: Vec<Vec3> = world
-            .boundary_positions()
-            .iter()
+        let walls = &world.boundary.positions;
+        let obstacle: Vec<Vec3> = (0..walls.len())
+            .map(|b| walls.at(b))
             .filter(|p| !on_wall(p))
-            .copied()
             .collect();
         self.render(&Frame {
             positions: &world.positions(),

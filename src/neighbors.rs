@@ -240,7 +240,7 @@ impl UniformGrid {
         out.blocks
             .par_iter_mut()
             .enumerate()
-            .for_each(|(b, (counts, found))| {
+            .for_each(|(b, (starts, found))| {
                 let first = b * BLOCK;
                 let queries = &queries[first..(first + BLOCK).min(queries.len())];
                 let block = Block {
@@ -250,17 +250,9 @@ impl UniformGrid {
                     r2,
                     exclude_self: first_self.map(|own| own + first),
                 };
-                block.search(queries, counts, found);
+                block.search(queries, starts, found);
             });
-        out.offsets.clear();
-        out.offsets.push(0);
-        let mut total = 0u32;
-        for (counts, _) in &out.blocks {
-            for &n in counts {
-                total += n;
-                out.offsets.push(total);
-            }
-        }
+        out.queries = queries.len();
     }
 }
 
@@ -286,14 +278,14 @@ impl CellTable {
 }
 
 /// Neighbour lists in compressed form, kept where the search wrote them: the queries are
-/// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`. The
-/// neighbours of query i are ascending, at `offsets[i]..offsets[i + 1]` counted over all
-/// blocks (so at those minus the block's first offset within its own block).
+/// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`, each list
+/// ascending.
 #[derive(Clone, Debug, Default)]
 pub struct NeighborLists {
-    /// Start of each query's list, counted over all blocks; one more entry than queries.
-    offsets: Vec<u32>,
-    /// Per block of queries: the number of neighbours of each, and their lists concatenated.
+    /// The number of queries.
+    queries: usize,
+    /// Per block of queries: where each query's list starts in the block's concatenated
+    /// lists (one more entry than queries), and those lists.
     blocks: Vec<(Vec<u32>, Vec<u32>)>,
     /// The searched points by component, for [`UniformGrid::search`].
     coordinates: PointsByComponent,
@@ -303,21 +295,22 @@ impl NeighborLists {
     /// The neighbours of query `i`.
     #[inline]
     pub fn of(&self, i: usize) -> &[u32] {
-        let b = i / BLOCK;
-        let base = self.offsets[b * BLOCK];
-        let (start, end) = (self.offsets[i] - base, self.offsets[i + 1] - base);
-        &self.blocks[b].1[start as usize..end as usize]
+        let (starts, found) = &self.blocks[i / BLOCK];
+        let k = i % BLOCK;
+        &found[starts[k] as usize..starts[k + 1] as usize]
     }
 
     /// The number of neighbours of query `i`.
     #[inline]
     pub fn count(&self, i: usize) -> usize {
-        (self.offsets[i + 1] - self.offsets[i]) as usize
+        let starts = &self.blocks[i / BLOCK].0;
+        let k = i % BLOCK;
+        (starts[k + 1] - starts[k]) as usize
     }
 
     /// Number of queries.
     pub fn len(&self) -> usize {
-        self.offsets.len().saturating_sub(1)
+        self.queries
     }
 
     /// True when there are no queries.
@@ -333,7 +326,7 @@ impl NeighborLists {
 
     /// The number of neighbours of all queries together (pairs found).
     pub fn pairs(&self) -> usize {
-        self.offsets.last().map_or(0, |&n| n as usize)
+        self.blocks.iter().map(|(_, found)| found.len()).sum()
     }
 }
 
@@ -474,16 +467,17 @@ struct Block<'a> {
 }
 
 impl Block<'_> {
-    /// Appends the neighbours of every query to `found` and their number to `counts`: eight
+    /// Replaces `found` with the neighbours of every query, one list after another, and
+    /// `starts` with where each list starts there (and, last, where the last one ends): eight
     /// distance tests per instruction in the AVX-512 build, four in the AVX2 build, the same
     /// lists from every build (tested).
-    fn search(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
+    fn search(&self, queries: &[Vec3], starts: &mut Vec<u32>, found: &mut Vec<u32>) {
         #[cfg(target_arch = "x86_64")]
         if crate::simd::has_avx512() {
             // SAFETY: the processor supports the build's features, checked just above.
-            return unsafe { self.search_avx512(queries, counts, found) };
+            return unsafe { self.search_avx512(queries, starts, found) };
         }
-        self.search_avx2_or_portable(queries, counts, found)
+        self.search_avx2_or_portable(queries, starts, found)
     }
 
     crate::simd::avx2_dispatch! {
@@ -491,7 +485,7 @@ impl Block<'_> {
         fn search_avx2_or_portable / search_avx2(
             &self,
             queries: &[Vec3],
-            counts: &mut Vec<u32>,
+            starts: &mut Vec<u32>,
             found: &mut Vec<u32>,
         ) where true => search_portable
     }
@@ -499,8 +493,8 @@ impl Block<'_> {
     /// The body of [`Block::search`] with the portable distance tests, inlined into the
     /// portable and the AVX2 build.
     #[inline(always)]
-    fn search_portable(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
-        self.search_with::<false, false>(queries, counts, found)
+    fn search_portable(&self, queries: &[Vec3], starts: &mut Vec<u32>, found: &mut Vec<u32>) {
+        self.search_with::<false, false>(queries, starts, found)
     }
 
     /// The AVX-512 build of [`Block::search`]. A point set searched among itself (a
@@ -511,13 +505,13 @@ impl Block<'_> {
     /// # Safety
     /// The processor must support what [`crate::simd::has_avx512`] checks.
     #[cfg(target_arch = "x86_64")]
-    unsafe fn search_avx512(&self, queries: &[Vec3], counts: &mut Vec<u32>, found: &mut Vec<u32>) {
+    unsafe fn search_avx512(&self, queries: &[Vec3], starts: &mut Vec<u32>, found: &mut Vec<u32>) {
         // SAFETY: as this function's.
         unsafe {
             if self.exclude_self.is_some() {
-                self.search_avx512_with::<false>(queries, counts, found)
+                self.search_avx512_with::<false>(queries, starts, found)
             } else {
-                self.search_avx512_with::<true>(queries, counts, found)
+                self.search_avx512_with::<true>(queries, starts, found)
             }
         }
     }
@@ -532,10 +526,10 @@ impl Block<'_> {
     unsafe fn search_avx512_with<const SPARSE: bool>(
         &self,
         queries: &[Vec3],
-        counts: &mut Vec<u32>,
+        starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
     ) {
-        self.search_with::<true, SPARSE>(queries, counts, found)
+        self.search_with::<true, SPARSE>(queries, starts, found)
     }
 
     /// The body of [`Block::search`]. With `AVX512` (only instantiated so by
@@ -547,12 +541,13 @@ impl Block<'_> {
     fn search_with<const AVX512: bool, const SPARSE: bool>(
         &self,
         queries: &[Vec3],
-        counts: &mut Vec<u32>,
+        starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
     ) {
         let grid = self.grid;
         let p = self.points;
-        counts.clear();
+        starts.clear();
+        starts.push(0);
         found.clear();
         // The points of the previous query's cell and its neighbour cells, in ascending
         // Z-rank of the cells (so their indices ascend and no list needs sorting): the
@@ -564,7 +559,6 @@ impl Block<'_> {
         // the AVX-512 build, which tests the ranges in place, leaves them empty).
         let (mut candidates, mut ids) = CANDIDATES.take();
         for (k, q) in queries.iter().enumerate() {
-            let start = found.len();
             let c = grid.cell_of(q);
             if cached != Some(c) {
                 cached = Some(c);
@@ -606,14 +600,14 @@ impl Block<'_> {
                 // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
                 // processor has AVX-512; the ranges lie within the table's points.
                 unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
-                counts.push((found.len() - start) as u32);
+                starts.push(found.len() as u32);
                 continue;
             }
             let own = self
                 .exclude_self
                 .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
             push_within_portable(q, &candidates, &ids, own, self.r2, found);
-            counts.push((found.len() - start) as u32);
+            starts.push(found.len() as u32);
         }
         CANDIDATES.set((candidates, ids));
     }
@@ -900,9 +894,9 @@ mod tests {
                 exclude_self,
             };
             let run = |build: &dyn Fn(&mut Vec<u32>, &mut Vec<u32>)| {
-                let (mut counts, mut found) = (Vec::new(), Vec::new());
-                build(&mut counts, &mut found);
-                (counts, found)
+                let (mut starts, mut found) = (Vec::new(), Vec::new());
+                build(&mut starts, &mut found);
+                (starts, found)
             };
             let reference = run(&|c, f| block.search_portable(&sorted, c, f));
             assert!(reference.1.len() > 20_000, "{} pairs", reference.1.len());

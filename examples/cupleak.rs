@@ -28,7 +28,7 @@ fn main() {
         params.chebyshev.auto_rho = false;
     }
     let mut world = pour_over_cup(params, &cup);
-    let b = world.boundary_positions();
+    let b = world.boundary_positions().to_vec();
     let boxes = cup_boxes(0.02);
     while world.time() < 0.8 {
         let s = world.step().unwrap().clone();

@@ -124,7 +124,7 @@ fn main() {
         }
     }
     if let Ok(path) = std::env::var("BDUMP") {
-        write_vec3s(&path, &world.boundary_positions());
+        write_vec3s(&path, world.boundary_positions());
     }
     let step_out: f64 = arg(5, "0.1").parse().unwrap();
     let initial = world.positions();

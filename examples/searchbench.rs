@@ -19,7 +19,7 @@ fn main() {
         .world;
     let repetitions: usize = a[1].parse().expect("repetitions");
     let fluid = world.positions();
-    let boundary = world.boundary_positions();
+    let boundary = world.boundary_positions().to_vec();
     let h = world.params().support_radius();
     let (mut lo, mut hi) = (fluid[0], fluid[0]);
     for p in boundary.iter().chain(&fluid) {

@@ -84,16 +84,17 @@ pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Ve
 }
 
 /// Akinci volumes V_b = 1/Σ_{b'} W(x_b − x_b') (self included) for boundary particles
-/// `points` sorted by `table` on `grid`, in m³. The neighbours are searched [`VOLUME_BATCH`]
-/// particles at a time, so that only one batch's lists are held (a whole boundary's were once
-/// the largest allocation of a world).
+/// `points` sorted by `table` on `grid` (`by_component`: the same points by component), in
+/// m³. The neighbours are searched [`VOLUME_BATCH`] particles at a time, so that only one
+/// batch's lists are held (a whole boundary's were once the largest allocation of a world).
 pub fn akinci_volumes(
     grid: &UniformGrid,
     table: &CellTable,
-    points: &PointsByComponent,
+    points: &[Vec3],
+    by_component: &PointsByComponent,
     kernel: &CubicKernel,
 ) -> Vec<f64> {
-    volumes_in_batches(grid, table, points, kernel, VOLUME_BATCH)
+    volumes_in_batches(grid, table, points, by_component, kernel, VOLUME_BATCH)
 }
 
 /// How many boundary particles [`akinci_volumes`] searches at a time.
@@ -103,24 +104,22 @@ const VOLUME_BATCH: usize = 1 << 14;
 fn volumes_in_batches(
     grid: &UniformGrid,
     table: &CellTable,
-    points: &PointsByComponent,
+    points: &[Vec3],
+    by_component: &PointsByComponent,
     kernel: &CubicKernel,
     batch: usize,
 ) -> Vec<f64> {
     let mut lists = NeighborLists::default();
     let mut volumes = Vec::with_capacity(points.len());
-    let mut queries = Vec::new();
     let h = kernel.support_radius();
     for first in (0..points.len()).step_by(batch) {
-        queries.clear();
-        queries
-            .extend((first..first.saturating_add(batch).min(points.len())).map(|b| points.at(b)));
-        grid.search_from(table, points, &queries, Some(first), h, &mut lists);
+        let queries = &points[first..first.saturating_add(batch).min(points.len())];
+        grid.search_from(table, by_component, queries, Some(first), h, &mut lists);
         volumes.par_extend(queries.par_iter().enumerate().map(|(k, x)| {
             let sum: f64 = lists
                 .of(k)
                 .iter()
-                .map(|&c| kernel.w((x - points.at(c as usize)).norm()))
+                .map(|&c| kernel.w((x - points[c as usize]).norm()))
                 .sum();
             1.0 / (kernel.w_zero() + sum)
         }));
@@ -179,7 +178,7 @@ mod tests {
         let sorted: Vec<Vec3> = order.iter().map(|&i| pts[i as usize]).collect();
         let mut by_component = PointsByComponent::default();
         by_component.fill(&sorted);
-        let volumes = akinci_volumes(&grid, &table, &by_component, &kernel);
+        let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, &kernel);
         let centre = sorted
             .iter()
             .position(|p| (p - Vec3::new(0.5, 0.0, 0.5)).norm() < 1e-9)
@@ -194,10 +193,10 @@ mod tests {
         assert!(volumes[corner] > 2.0 * volumes[centre]);
         // Searched in batches of any size (one point, a few, or more than a cell's), every
         // volume comes out bit for bit as from one search of all points.
-        let whole = volumes_in_batches(&grid, &table, &by_component, &kernel, usize::MAX);
+        let whole = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, usize::MAX);
         assert_eq!(volumes, whole);
         for batch in [1, 7, 100, 1000] {
-            let parts = volumes_in_batches(&grid, &table, &by_component, &kernel, batch);
+            let parts = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, batch);
             assert_eq!(parts, whole, "batches of {batch}");
         }
     }

@@ -3,7 +3,7 @@
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;
-use crate::neighbors::{NeighborLists, PointsByComponent, par_segments_zip_mut};
+use crate::neighbors::{NeighborLists, par_segments_zip_mut};
 use crate::params::ProjectionWeight;
 use rayon::prelude::*;
 
@@ -37,7 +37,7 @@ pub struct Neighborhood<'a> {
     /// Boundary neighbours of each fluid particle.
     pub boundary: &'a NeighborLists,
     /// Boundary particle positions (m).
-    pub boundary_positions: &'a PointsByComponent,
+    pub boundary_positions: &'a [Vec3],
     /// Boundary particle masses ψ_b (kg).
     pub boundary_psi: &'a [f64],
     /// The weight w_j of every fluid particle in a projection
@@ -346,7 +346,7 @@ impl DensityConstraint {
             .iter()
             .map(|&b| {
                 let b = b as usize;
-                nb.boundary_psi[b] * k.w((xi - nb.boundary_positions.at(b)).norm())
+                nb.boundary_psi[b] * k.w((xi - nb.boundary_positions[b]).norm())
             })
             .sum();
         self.mass * (k.w_zero() + fluid) + boundary
@@ -407,7 +407,7 @@ impl DensityConstraint {
             .zip(&mut bm.rz)
             .zip(&mut bm.psi)
         {
-            let xb = nb.boundary_positions.at(b as usize);
+            let xb = &nb.boundary_positions[b as usize];
             (*rx, *ry, *rz) = (xi.x - xb.x, xi.y - xb.y, xi.z - xb.z);
             *psi = nb.boundary_psi[b as usize];
         }
@@ -863,7 +863,7 @@ impl DensityConstraint {
             .iter()
             .map(|&b| {
                 let b = b as usize;
-                kernel.grad_w(&(pi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
+                kernel.grad_w(&(pi - nb.boundary_positions[b])) * nb.boundary_psi[b]
             })
             .sum::<Vec3>()
             / self.rest_density;
@@ -987,7 +987,7 @@ mod tests {
             Neighborhood {
                 fluid: &self.fl,
                 boundary: &self.bl,
-                boundary_positions: self.bl.searched_points(),
+                boundary_positions: &self.bx,
                 boundary_psi: &self.psi,
                 weights: &self.weights,
             }

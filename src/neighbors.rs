@@ -130,27 +130,15 @@ impl UniformGrid {
     /// stable) and the table of cell ranges. Returns whether every point lies inside the
     /// grid's domain ([`UniformGrid::covers`]), from the same pass.
     pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) -> bool {
-        self.sort_with(points.len(), |i| points[i], order, table)
-    }
-
-    /// [`UniformGrid::sort`] of the `n` points `point(0..n)`.
-    pub(crate) fn sort_with(
-        &self,
-        n: usize,
-        point: impl Fn(usize) -> Vec3 + Sync,
-        order: &mut Vec<u32>,
-        table: &mut CellTable,
-    ) -> bool {
         let ranks = &mut table.ranks;
-        ranks.resize(n, 0);
+        ranks.resize(points.len(), 0);
         let domain = self.domain();
         let covered = ranks
             .par_iter_mut()
-            .enumerate()
-            .map(|(i, r)| {
-                let p = point(i);
-                *r = self.rank(self.cell_of(&p)) as u32;
-                inside(&p, &domain)
+            .zip(points.par_iter())
+            .map(|(r, p)| {
+                *r = self.rank(self.cell_of(p)) as u32;
+                inside(p, &domain)
             })
             .reduce(|| true, |a, b| a && b);
         let starts = &mut table.cell_start;
@@ -163,7 +151,7 @@ impl UniformGrid {
             starts[c + 1] += starts[c];
         }
         order.clear();
-        order.resize(n, 0);
+        order.resize(points.len(), 0);
         // Each cell's start serves as its cursor, which leaves it at the cell's end, the
         // next cell's start; shifting by one cell restores the starts.
         for (i, &r) in ranks.iter().enumerate() {
@@ -398,50 +386,6 @@ impl PointsByComponent {
     /// True when there are no points.
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
-    }
-
-    /// Appends `points` (m).
-    pub fn extend_from(&mut self, points: &[Vec3]) {
-        self.x.extend(points.iter().map(|p| p.x));
-        self.y.extend(points.iter().map(|p| p.y));
-        self.z.extend(points.iter().map(|p| p.z));
-    }
-
-    /// Reserves room for `additional` more points.
-    pub fn try_reserve(
-        &mut self,
-        additional: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
-        self.x.try_reserve(additional)?;
-        self.y.try_reserve(additional)?;
-        self.z.try_reserve(additional)
-    }
-
-    /// The points (m), copied.
-    pub fn to_vec(&self) -> Vec<Vec3> {
-        (0..self.len()).map(|i| self.at(i)).collect()
-    }
-
-    /// The points (m) in the order `order` (slot k ← point `order[k]`).
-    pub fn permuted(&self, order: &[u32]) -> Self {
-        let take = |c: &[f64]| order.par_iter().map(|&i| c[i as usize]).collect();
-        Self {
-            x: take(&self.x),
-            y: take(&self.y),
-            z: take(&self.z),
-        }
-    }
-
-    /// The smallest box holding every point, or `None` for none (m).
-    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        let range = |c: &[f64]| {
-            c.iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &v| {
-                    (lo.min(v), hi.max(v))
-                })
-        };
-        let (x, y, z) = (range(&self.x), range(&self.y), range(&self.z));
-        (!self.is_empty()).then(|| (Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1)))
     }
 
     /// Replaces the contents with `points` (m), in one parallel pass.

@@ -192,7 +192,7 @@ impl World {
             );
             grid.search_in(
                 &boundary.table,
-                &boundary.positions,
+                &boundary.by_component,
                 &b.current,
                 h,
                 false,

@@ -24,12 +24,12 @@ pub(crate) struct Fluid {
 /// Static boundary particles, sorted by the grid's cells, with their Akinci masses.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Boundary {
-    /// The positions (m) by component, as the neighbour search and the constraint read them
-    /// (one copy only: a boundary can hold more particles than the fluid).
-    pub positions: PointsByComponent,
+    pub positions: Vec<Vec3>,
     /// ψ_b = ρ0·V_b (kg), valid unless `dirty`.
     pub psi: Vec<f64>,
     pub table: CellTable,
+    /// `positions` by component, for the neighbour search (valid unless `dirty`).
+    pub by_component: PointsByComponent,
     /// Set when particles were added or the grid changed: sort and volumes must be redone.
     pub dirty: bool,
 }
@@ -223,7 +223,7 @@ impl World {
                 "would exceed the boundary particle limit",
             ));
         }
-        self.boundary.positions.extend_from(positions);
+        self.boundary.positions.extend_from_slice(positions);
         self.boundary.dirty = true;
         Ok(())
     }
@@ -364,9 +364,9 @@ impl World {
         out
     }
 
-    /// Static boundary particle positions (m), in the world's storage order (a copy).
-    pub fn boundary_positions(&self) -> Vec<Vec3> {
-        self.boundary.positions.to_vec()
+    /// Static boundary particle positions (m), in the world's storage order.
+    pub fn boundary_positions(&self) -> &[Vec3] {
+        &self.boundary.positions
     }
 
     /// Kinetic energy Σ ½m|v|² (J).
@@ -449,11 +449,9 @@ impl World {
     pub(crate) fn prepare_grid(&mut self, points: &[Vec3], outgrown: bool) {
         let outgrown = self.grid.is_none() || (outgrown && !self.grid_capped);
         if outgrown || self.boundary.dirty {
-            let walls = self.boundary.positions.bounds();
-            let walls = walls.map(|(min, max)| Aabb { min, max });
-            let bounds = [Aabb::around(points), walls]
-                .into_iter()
-                .flatten()
+            let bounds = [points, &self.boundary.positions]
+                .iter()
+                .filter_map(|p| Aabb::around(p))
                 .reduce(|a, b| a.union(&b));
             let Some(bounds) = bounds else { return };
             let finite = |v: Vec3| {
@@ -484,12 +482,12 @@ impl World {
         let b = &mut self.boundary;
         let mut order = Vec::new();
         self.pool.install(|| {
-            let n = b.positions.len();
-            grid.sort_with(n, |i| b.positions.at(i), &mut order, &mut b.table);
+            grid.sort(&b.positions, &mut order, &mut b.table);
             b.table.release_scratch();
-            b.positions = b.positions.permuted(&order);
+            b.positions = order.iter().map(|&i| b.positions[i as usize]).collect();
+            b.by_component.fill(&b.positions);
             let kernel = &self.constraint.kernel;
-            let volumes = akinci_volumes(grid, &b.table, &b.positions, kernel);
+            let volumes = akinci_volumes(grid, &b.table, &b.positions, &b.by_component, kernel);
             b.psi = volumes
                 .iter()
                 .map(|v| v * self.params.rest_density)

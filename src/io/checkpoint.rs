@@ -127,9 +127,8 @@ pub fn write_checkpoint(
     for id in &f.ids {
         bytes.extend_from_slice(&id.to_le_bytes());
     }
-    let walls = &world.boundary.positions;
-    for b in 0..walls.len() {
-        push_vec3(&mut bytes, &walls.at(b));
+    for p in &world.boundary.positions {
+        push_vec3(&mut bytes, p);
     }
     let digest = Sha256::digest(&bytes);
     bytes.extend_from_slice(&digest);

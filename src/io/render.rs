@@ -224,10 +224,11 @@ impl Renderer {
                 c.contains(p, 2.5 * r) && !deep_inside
             })
         };
-        let walls = &world.boundary.positions;
-        let obstacle: Vec<Vec3> = (0..walls.len())
-            .map(|b| walls.at(b))
+        let obstacle: Vec<Vec3> = world
+            .boundary_positions()
+            .iter()
             .filter(|p| !on_wall(p))
+            .copied()
             .collect();
         self.render(&Frame {
             positions: &world.positions(),

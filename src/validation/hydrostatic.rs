@@ -384,8 +384,7 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
     let h = params.support_radius();
     let fluid = &world.fluid.positions;
     let boundary = &world.boundary;
-    let boundary_positions = boundary.positions.to_vec();
-    let bounds = [fluid.as_slice(), &boundary_positions]
+    let bounds = [fluid.as_slice(), &boundary.positions]
         .iter()
         .filter_map(|p| Aabb::around(p))
         .reduce(|a, b| a.union(&b));
@@ -401,11 +400,11 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         };
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
         let fluid_order = sorted(fluid, &mut fluid_table);
-        let boundary_order = sorted(&boundary_positions, &mut boundary_table);
+        let boundary_order = sorted(&boundary.positions, &mut boundary_table);
         let x: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
         let bx: Vec<Vec3> = boundary_order
             .iter()
-            .map(|&i| boundary_positions[i as usize])
+            .map(|&i| boundary.positions[i as usize])
             .collect();
         let psi: Vec<f64> = boundary_order
             .iter()
@@ -420,7 +419,7 @@ fn constraint_pressures(world: &World) -> (Vec<(Vec3, f64)>, f64) {
         let nb = Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,
-            boundary_positions: boundary_lists.searched_points(),
+            boundary_positions: &bx,
             boundary_psi: &psi,
             weights: &weights,
         };

@@ -894,8 +894,9 @@ mod tests {
                 let sorted = sorted_copy(&grid, &pts, &mut table);
                 let mut lists = NeighborLists::default();
                 grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
-                let all: Vec<Vec<u32>> = (0..lists.len()).map(|i| lists.of(i).to_vec()).collect();
-                all
+                (0..lists.len())
+                    .map(|i| lists.of(i).to_vec())
+                    .collect::<Vec<_>>()
             })
         };
         assert_eq!(run(1), run(3));

@@ -14,7 +14,8 @@ use std::time::Instant;
 /// Buffers reused by every step, so that a step allocates nothing once sizes are stable.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct StepBuffers {
-    /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m).
+    /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m). `current` receives the prediction
+    /// s at the start of a step; `next` also serves the reordering and XSPH as scratch.
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,

@@ -4,6 +4,7 @@
 //! `cargo run --release --example searchbench -- CHECKPOINT REPETITIONS`, where CHECKPOINT
 //! is a file written by `projfluid run --checkpoint-every N`. Prints three rounds of mean
 //! times per search (ms) with the number of pairs found.
+use projfluid::boundary::Aabb;
 use projfluid::neighbors::{CellTable, NeighborLists, UniformGrid};
 use std::time::Instant;
 
@@ -19,14 +20,14 @@ fn main() {
         .world;
     let repetitions: usize = a[1].parse().expect("repetitions");
     let fluid = world.positions();
-    let boundary = world.boundary_positions().to_vec();
+    let boundary = world.boundary_positions();
     let h = world.params().support_radius();
-    let (mut lo, mut hi) = (fluid[0], fluid[0]);
-    for p in boundary.iter().chain(&fluid) {
-        lo = lo.inf(p);
-        hi = hi.sup(p);
-    }
-    let grid = UniformGrid::covering(lo, hi, h);
+    let bounds = [&fluid[..], boundary]
+        .into_iter()
+        .filter_map(Aabb::around)
+        .reduce(|a, b| a.union(&b))
+        .expect("the checkpoint holds particles");
+    let grid = UniformGrid::covering(bounds.min, bounds.max, h);
     // The points in the grid's order, with the table of their cells.
     let sorted = |points: &[projfluid::Vec3], table: &mut CellTable| {
         let mut order = Vec::new();
@@ -43,7 +44,7 @@ fn main() {
     pool.install(|| {
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
         let fluid = sorted(&fluid, &mut fluid_table);
-        let boundary = sorted(&boundary, &mut boundary_table);
+        let boundary = sorted(boundary, &mut boundary_table);
         let (mut fluid_lists, mut boundary_lists) =
             (NeighborLists::default(), NeighborLists::default());
         let time = |search: &mut dyn FnMut()| {

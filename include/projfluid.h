@@ -106,13 +106,13 @@ typedef enum PfSolver {
  */
 typedef enum PfOmega2Rule {
     /**
-     * ω₂ = 2/(2 − ρ²) (the default).
+     * ω₂ = 2/(2 − ρ²), the Chebyshev-polynomial start (Wang 2015).
      */
     PF_OMEGA2_CHEBYSHEV = 0,
     /**
-     * ω₂ = 4/(4 − ρ²).
+     * ω₂ = 4/(4 − ρ²), as Sommer et al. (2020) state it (the default).
      */
-    PF_OMEGA2_SEED = 1,
+    PF_OMEGA2_PAPER = 1,
 } PfOmega2Rule;
 
 /**
@@ -196,7 +196,7 @@ typedef struct PfParams {
      */
     enum PfSolver solver;
     /**
-     * Rule for the first Chebyshev weight. Default `PF_OMEGA2_SEED`.
+     * Rule for the first Chebyshev weight. Default `PF_OMEGA2_PAPER`.
      */
     enum PfOmega2Rule omega2_rule;
     /**

@@ -1,5 +1,5 @@
 //! Solid boundaries as static particles (Akinci et al. 2012): sampling of container walls and
-//! of triangle meshes ([`mesh`]), and the boundary volumes ψ_b/ρ0 (ALGORITHM.md §2.6, §7).
+//! of triangle meshes ([`mesh`]), and the boundary volumes ψ_b/ρ0 (docs/method.md §2.6, §7).
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;

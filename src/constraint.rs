@@ -1,5 +1,5 @@
 //! The SPH density constraint C_i = max(ρ_i/ρ0 − 1, 0) and its local projection
-//! (ALGORITHM.md §2.3–2.5).
+//! (docs/method.md §2.3–2.5).
 
 use crate::Vec3;
 use crate::kernel::CubicKernel;
@@ -7,7 +7,7 @@ use crate::neighbors::{NeighborLists, par_segments_zip_mut};
 use crate::params::ProjectionWeight;
 use rayon::prelude::*;
 
-/// The local projection stops once C_i ≤ this value ([SEED], [SPH]).
+/// The local projection stops once C_i ≤ this value (Sommer et al. 2020, Weiler et al. 2016).
 const CONSTRAINT_GOAL: f64 = 1e-14;
 /// At most this many Newton-like steps per projection.
 const MAX_PROJECTION_STEPS: usize = 100;
@@ -583,7 +583,7 @@ impl DensityConstraint {
         self.first_density(i, x[i], x, nb, scratch)
     }
 
-    /// The XSPH-filtered velocity of fluid particle i (m/s), ALGORITHM.md §1.3:
+    /// The XSPH-filtered velocity of fluid particle i (m/s), docs/method.md §1.3:
     /// v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij, with positions `x` (m), velocities `v` (m/s)
     /// and volumes m/ρ_j (m³) of the fluid (one division per particle, not per pair).
     pub fn xsph_velocity(
@@ -634,7 +634,7 @@ impl DensityConstraint {
         vi + sum * c
     }
 
-    /// The weight w_j of every fluid particle j in a projection (ALGORITHM.md §2.5), given
+    /// The weight w_j of every fluid particle j in a projection (docs/method.md §2.5), given
     /// the fluid's neighbour lists, written into `out` (for [`Neighborhood::weights`]).
     pub fn weights(&self, lists: &NeighborLists, out: &mut Vec<f64>) {
         out.clear();
@@ -645,14 +645,14 @@ impl DensityConstraint {
         }));
     }
 
-    /// The weight w_j of fluid particle j in a projection (ALGORITHM.md §2.5).
+    /// The weight w_j of fluid particle j in a projection (docs/method.md §2.5).
     #[inline]
     fn weight_of(&self, nb: &Neighborhood, j: usize) -> f64 {
         nb.weights[j]
     }
 
     /// How many stencils the global step counts particle j as a member of: n_j + 1, or c
-    /// for [`ProjectionWeight::Uniform`] (ALGORITHM.md §3.1; README, "Projection weighting").
+    /// for [`ProjectionWeight::Uniform`] (docs/method.md §3.1; docs/solvers.md, "Projection weighting").
     #[inline]
     pub fn membership(&self, nb: &NeighborLists, j: usize) -> f64 {
         match self.weight {
@@ -879,7 +879,7 @@ impl DensityConstraint {
     }
 
     crate::simd::avx2_dispatch! {
-        /// Projection of constraint i (ALGORITHM.md §2.5): Newton-like steps on a private
+        /// Projection of constraint i (docs/method.md §2.5): Newton-like steps on a private
         /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after
         /// its first step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]`
         /// (s-th neighbour) receive the corrections. The AVX2 build runs the loops over a

@@ -1,5 +1,5 @@
 //! The cubic B-spline SPH kernel (Monaghan's M4 spline written over its support radius H),
-//! ALGORITHM.md §2.1.
+//! docs/method.md §2.1.
 
 use crate::Vec3;
 use std::f64::consts::PI;
@@ -151,7 +151,7 @@ mod tests {
 
     #[test]
     fn lattice_sum_is_one() {
-        // Σ_j W(x_i − x_j) d³ over a cubic lattice of spacing d = H/2 (ALGORITHM.md §2.2: 0.99997).
+        // Σ_j W(x_i − x_j) d³ over a cubic lattice of spacing d = H/2 (docs/method.md §2.2: 0.99997).
         let h = 0.1;
         let d = h / 2.0;
         let kernel = CubicKernel::new(h);
@@ -182,7 +182,7 @@ mod tests {
         assert!((kernel.w(0.05) - kernel.w_zero() / 4.0).abs() < 1e-9);
     }
 
-    /// The branch-free forms equal the piecewise definitions of ALGORITHM.md §2.1, on both
+    /// The branch-free forms equal the piecewise definitions of docs/method.md §2.1, on both
     /// sides of q = ½, at q = ½ and 1 exactly, and beyond the support.
     #[test]
     fn branch_free_forms_match_the_piecewise_spline() {

@@ -14,17 +14,15 @@
 //!
 //! Units are SI throughout: metres, seconds, kilograms.
 
-pub mod bench;
 pub mod boundary;
 pub mod constraint;
-pub mod driver;
 mod error;
 pub mod ffi;
 pub mod io;
 pub mod kernel;
 pub mod neighbors;
 pub mod params;
-pub mod plot;
+pub mod pressure;
 mod random;
 pub mod reduce;
 pub mod scene;
@@ -32,9 +30,6 @@ mod simd;
 pub mod solver;
 pub mod stats;
 mod step;
-mod table;
-pub mod tuning;
-pub mod validation;
 mod world;
 
 pub use error::Error;

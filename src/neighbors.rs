@@ -1,4 +1,4 @@
-//! Neighbour search on a uniform grid (ALGORITHM.md §6): cells of edge H, a counting sort of the
+//! Neighbour search on a uniform grid (docs/method.md §6): cells of edge H, a counting sort of the
 //! particles by cell in Z-order (Morton order), and compressed (CSR) neighbour lists built in
 //! parallel. Every output depends only on the input positions, never on the thread count.
 

@@ -1,8 +1,8 @@
-//! Simulation parameters with their defaults (ALGORITHM.md Appendix A) and validation.
+//! Simulation parameters with their defaults (docs/method.md Appendix A) and validation.
 
 use crate::Error;
 
-/// Which global solver runs in each outer iteration (ALGORITHM.md §3).
+/// Which global solver runs in each outer iteration (docs/method.md §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SolverKind {
     /// One Jacobi sweep plus Chebyshev extrapolation over the outer iterations (§3.7).
@@ -82,27 +82,27 @@ macro_rules! serde_by_name {
 
 serde_by_name!(SolverKind);
 
-/// How ω₂, the first Chebyshev weight, is chosen (ALGORITHM.md §3.7).
+/// How ω₂, the first Chebyshev weight, is chosen (docs/method.md §3.7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Omega2Rule {
     /// ω₂ = 2/(2 − ρ²), the Chebyshev-polynomial start (Wang 2015).
     Chebyshev,
-    /// ω₂ = 4/(4 − ρ²), the seed paper's text read literally.
-    SeedLiteral,
+    /// ω₂ = 4/(4 − ρ²), as Sommer et al. (2020) state it (the default).
+    Paper,
 }
 
 impl Omega2Rule {
     /// Every rule.
-    pub const ALL: [Omega2Rule; 2] = [Omega2Rule::Chebyshev, Omega2Rule::SeedLiteral];
+    pub const ALL: [Omega2Rule; 2] = [Omega2Rule::Chebyshev, Omega2Rule::Paper];
 
     /// Every rule's name, in the order of [`Omega2Rule::ALL`].
-    pub const NAMES: [&'static str; 2] = ["chebyshev", "seed"];
+    pub const NAMES: [&'static str; 2] = ["chebyshev", "paper"];
 
     /// The rule's name in scenes and on the command line.
     pub fn name(self) -> &'static str {
         match self {
             Omega2Rule::Chebyshev => "chebyshev",
-            Omega2Rule::SeedLiteral => "seed",
+            Omega2Rule::Paper => "paper",
         }
     }
 
@@ -114,7 +114,7 @@ impl Omega2Rule {
 
 serde_by_name!(Omega2Rule);
 
-/// Weight w_j applied to a particle's share of a local projection (ALGORITHM.md §2.5).
+/// Weight w_j applied to a particle's share of a local projection (docs/method.md §2.5).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ProjectionWeight {
     /// w_j = n_j + 1, the fluid neighbour count plus one (the reference behaviour).
@@ -126,7 +126,7 @@ pub enum ProjectionWeight {
     /// ones plus inactive "stay" terms). The converged step's constraint forces are then
     /// k·c·Σ_i λ_i ∇_{x_j}C_i, the gradient of one energy, and conserve momentum; with
     /// `NeighborCount` they are scaled per particle by n_j + 1, which is not conservative
-    /// (README, "Projection weighting"). Experimental: it keeps a resting column calmer, but
+    /// (docs/solvers.md, "Projection weighting"). Experimental: it keeps a resting column calmer, but
     /// splashing flows gain energy with it unless Chebyshev's γ is 0.8 or less.
     Uniform,
 }
@@ -159,7 +159,7 @@ impl ProjectionWeight {
 
 serde_by_name!(ProjectionWeight);
 
-/// Settings of Chebyshev's semi-iterative acceleration (ALGORITHM.md §3.7).
+/// Settings of Chebyshev's semi-iterative acceleration (docs/method.md §3.7).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ChebyshevParams {
     /// Estimated spectral radius ρ_c of the outer iteration, in [0, 1).
@@ -170,7 +170,7 @@ pub struct ChebyshevParams {
     pub omega2_rule: Omega2Rule,
     /// Under-relaxation γ in (0, 1].
     pub gamma: f64,
-    /// Estimate ρ_c online instead of using `rho` (README, "Choosing ρ"): every step of five
+    /// Estimate ρ_c online instead of using `rho` (docs/solvers.md, "Choosing ρ"): every step of five
     /// or more outer iterations estimates the plain iteration's contraction μ from how fast
     /// its own extrapolated iterates contracted, and ρ_c = 0.97·μ (smoothed, clamped to
     /// [0.5, 0.925]); `rho` is only the value used until the first estimate. On by default
@@ -179,10 +179,10 @@ pub struct ChebyshevParams {
     pub auto_rho: bool,
 }
 
-/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults"); also the
+/// Chosen by measurement on `dam_break_30k` (docs/method.md §4); also the
 /// starting value of the online estimate.
 pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.85;
-/// Chosen by measurement on `dam_break_30k` (README, "Choosing the defaults").
+/// Chosen by measurement on `dam_break_30k` (docs/method.md §4).
 pub const DEFAULT_CHEBYSHEV_DELAY: usize = 1;
 
 impl Default for ChebyshevParams {
@@ -190,7 +190,7 @@ impl Default for ChebyshevParams {
         Self {
             rho: DEFAULT_CHEBYSHEV_RHO,
             delay: DEFAULT_CHEBYSHEV_DELAY,
-            omega2_rule: Omega2Rule::SeedLiteral,
+            omega2_rule: Omega2Rule::Paper,
             gamma: 1.0,
             auto_rho: true,
         }
@@ -239,11 +239,11 @@ pub struct Params {
 /// Default particle radius (m).
 pub const DEFAULT_PARTICLE_RADIUS: f64 = 0.025;
 /// Default τ as a multiple of the particle radius: chosen by measurement on `dam_break_30k`
-/// (README, "Choosing the defaults"); ALGORITHM.md §4 suggests 1e-3.
+/// (docs/method.md §4); docs/method.md §4 suggests 1e-3.
 pub const DEFAULT_TOLERANCE_PER_RADIUS: f64 = 3e-3;
 
 /// τ of [`Params::calm`] as a multiple of the particle radius: at 3e-4 a settled column moves
-/// at 0.2–0.3 cm/s after 2 s, at 3e-3 still at 1.5–4 cm/s (README, "A tank at rest").
+/// at 0.2–0.3 cm/s after 2 s, at 3e-3 still at 1.5–4 cm/s (docs/validation.md, "Tank at rest").
 pub const CALM_TOLERANCE_PER_RADIUS: f64 = 3e-4;
 
 impl Default for Params {
@@ -276,7 +276,7 @@ impl Params {
         }
     }
 
-    /// These parameters with the calm settings (README, "A tank at rest: the calm settings"):
+    /// These parameters with the calm settings (docs/solvers.md, "A tank at rest: the calm settings"):
     /// the [`ProjectionWeight::Uniform`] weighting, whose converged constraint forces derive
     /// from one energy; τ = [`CALM_TOLERANCE_PER_RADIUS`]·r; Chebyshev at a fixed ρ = 0.99
     /// with γ = 0.5, which keeps the iteration convergent in fully compressed fluid (where the

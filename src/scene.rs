@@ -1,5 +1,5 @@
 //! Scenes: a fluid setup (parameters, container boxes, blocks of fluid, duration, output)
-//! read from JSON (format in the README ("Scene files")) or taken from the built-in list.
+//! read from JSON (format in docs/scene-format.md) or taken from the built-in list.
 //!
 //! ```
 //! use projfluid::scene::Scene;
@@ -328,7 +328,7 @@ mod tests {
             "gravity": [0, 0, -9.8],
             "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "layers": 2}],
             "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2], "velocity": [0, 1, 0]}],
-            "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "seed", "gamma": 0.9,
+            "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "paper", "gamma": 0.9,
                        "tau": 1e-6, "max_iterations": 50, "min_iterations": 2,
                        "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
@@ -350,7 +350,7 @@ mod tests {
         assert_eq!(p.solver, crate::SolverKind::Jacobi);
         assert_eq!(p.chebyshev.rho, 0.8);
         assert_eq!(p.chebyshev.delay, 2);
-        assert_eq!(p.chebyshev.omega2_rule, crate::Omega2Rule::SeedLiteral);
+        assert_eq!(p.chebyshev.omega2_rule, crate::Omega2Rule::Paper);
         assert_eq!(p.chebyshev.gamma, 0.9);
         assert_eq!(p.displacement_tolerance, 1e-6);
         assert_eq!((p.min_outer_iterations, p.max_outer_iterations), (2, 50));
@@ -378,7 +378,7 @@ mod tests {
         custom.params.displacement_tolerance = 1.0 / 3.0 * 1e-4;
         custom.params.solver = crate::SolverKind::Jacobi1;
         custom.params.projection_weight = crate::ProjectionWeight::Unit;
-        custom.params.chebyshev.omega2_rule = crate::Omega2Rule::SeedLiteral;
+        custom.params.chebyshev.omega2_rule = crate::Omega2Rule::Paper;
         custom.output.dir = Some(PathBuf::from("out [1]/frames"));
         custom.description = "quotes \" and [brackets]".to_string();
         scenes.push(custom);
@@ -419,7 +419,7 @@ mod tests {
         ] {
             assert_eq!(Scene::builtin(name).unwrap().particle_count(), count);
         }
-        // One particle radius across scenes (ALGORITHM.md §9).
+        // One particle radius across scenes (docs/method.md §9).
         for name in Scene::builtin_names() {
             assert_eq!(Scene::builtin(name).unwrap().params.particle_radius, 0.025);
         }
@@ -649,12 +649,12 @@ mod tests {
 
     #[test]
     fn documented_example_is_valid() {
-        let doc = include_str!("../README.md");
+        let doc = include_str!("../docs/scene-format.md");
         let example = doc
             .split("```json\n")
             .nth(1)
             .and_then(|rest| rest.split("```").next())
-            .expect("README.md has a json scene example");
+            .expect("docs/scene-format.md has a json scene example");
         let scene = Scene::from_json(example).unwrap();
         let mut expected = Scene::builtin("dam_break_small").unwrap();
         expected.description = scene.description.clone();

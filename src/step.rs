@@ -1,4 +1,4 @@
-//! One time step (ALGORITHM.md §1.3): predict, search neighbours, iterate local projections and
+//! One time step (docs/method.md §1.3): predict, search neighbours, iterate local projections and
 //! global solves (with Chebyshev extrapolation) until the displacement rule stops, update
 //! velocities, apply XSPH, and choose the next step size by the CFL rule (§8).
 
@@ -89,7 +89,7 @@ impl World {
     /// (s), and after every step of Δt scales every velocity by exp(−`damping`·Δt), `damping`
     /// being a rate (1/s, ≥ 0; 0 is [`World::advance`]). Meant for a settled start: a lattice
     /// of particles is not at rest under gravity (its layers slide into each other's hollows)
-    /// and 10 s at 4/s bring a tank to its equilibrium packing (README, "A tank at rest").
+    /// and 10 s at 4/s bring a tank to its equilibrium packing (docs/validation.md, "Tank at rest").
     /// Returns the number of steps taken.
     pub fn relax(&mut self, seconds: f64, damping: f64) -> Result<usize, Error> {
         if !(damping.is_finite() && damping >= 0.0) {
@@ -413,7 +413,7 @@ fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
     reduce::max_over(a.len(), |i| (a[i] - b[i]).norm())
 }
 
-/// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (ALGORITHM.md §1.3), with the
+/// XSPH filter v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij (docs/method.md §1.3), with the
 /// buffers for the volumes m/ρ_j and the new velocities.
 fn xsph(
     c: f64,

@@ -14,7 +14,7 @@ use projfluid::{Params, SolverKind};
 /// none outside the tank. Steps move particles at most 0.2·2r = 1 cm (CFL), so a particle
 /// crossing a 2 cm wall would be seen at least 5 mm deep for at least one step. (A particle
 /// grazing a convex corner of the rim alone, with few neighbours and so a soft constraint,
-/// may dip a few millimetres into it: README, Known limitations.)
+/// may dip a few millimetres into it: README, "Limitations".)
 fn pour_and_check(params: Params) {
     let cup = thin_walled_cup(0.02);
     assert!(is_closed_and_oriented(&cup));

@@ -29,10 +29,10 @@ pub enum PfSolver {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[allow(non_camel_case_types)]
 pub enum PfOmega2Rule {
-    /// ω₂ = 2/(2 − ρ²) (the default).
+    /// ω₂ = 2/(2 − ρ²), the Chebyshev-polynomial start (Wang 2015).
     PF_OMEGA2_CHEBYSHEV = 0,
-    /// ω₂ = 4/(4 − ρ²).
-    PF_OMEGA2_SEED = 1,
+    /// ω₂ = 4/(4 − ρ²), as Sommer et al. (2020) state it (the default).
+    PF_OMEGA2_PAPER = 1,
 }
 
 /// Weight of a particle's share of a local projection.
@@ -71,7 +71,7 @@ pub struct PfParams {
     pub gravity: [f64; 3],
     /// The global solver. Default `PF_SOLVER_CHEBYSHEV`.
     pub solver: PfSolver,
-    /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_SEED`.
+    /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_PAPER`.
     pub omega2_rule: PfOmega2Rule,
     /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
     /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.85.
@@ -126,7 +126,7 @@ impl From<&Params> for PfParams {
             },
             omega2_rule: match p.chebyshev.omega2_rule {
                 Omega2Rule::Chebyshev => PfOmega2Rule::PF_OMEGA2_CHEBYSHEV,
-                Omega2Rule::SeedLiteral => PfOmega2Rule::PF_OMEGA2_SEED,
+                Omega2Rule::Paper => PfOmega2Rule::PF_OMEGA2_PAPER,
             },
             chebyshev_rho: p.chebyshev.rho,
             chebyshev_delay: small(p.chebyshev.delay),
@@ -183,7 +183,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
     };
     let omega2_rule = match code!(omega2_rule) {
         0 => Omega2Rule::Chebyshev,
-        1 => Omega2Rule::SeedLiteral,
+        1 => Omega2Rule::Paper,
         n => {
             return Err(Failure::invalid(format!(
                 "params->omega2_rule must be a PfOmega2Rule, got {n}"

@@ -1,9 +1,8 @@
-//! Readers and writers: VTK and PLY frames, OBJ meshes, PNG pictures, checkpoints.
+//! Readers and writers: VTK and PLY frames, OBJ meshes, checkpoints.
 
 pub mod checkpoint;
 pub mod obj;
 pub mod ply;
-pub mod render;
 pub mod vtk;
 
 pub use obj::load_obj;

@@ -1,4 +1,4 @@
-//! The JSON form of a scene: serde structures mirroring the README ("Scene files"), their
+//! The JSON form of a scene: serde structures mirroring docs/scene-format.md, their
 //! conversion to and from [`Scene`], and a printer that keeps number arrays on one line.
 
 use super::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};

@@ -1,4 +1,4 @@
-//! Matrix-free, unpreconditioned conjugate gradients on A = Â ⊗ I₃ (ALGORITHM.md §3).
+//! Matrix-free, unpreconditioned conjugate gradients on A = Â ⊗ I₃ (docs/method.md §3).
 //!
 //! The three coordinates are solved together as one N×3 block: every inner product sums over
 //! all three coordinates, so α and β are shared. Because A = Â ⊗ I₃, this is plain CG on the

@@ -1,6 +1,6 @@
 //! Chebyshev semi-iterative acceleration of the outer local/global iteration
-//! (ALGORITHM.md §3.7, [SEED] eq. 8, [WANG15]), with a fixed ρ_c or one estimated online from
-//! the accelerated steps themselves ([`ChebyshevParams::auto_rho`]; README, "Choosing ρ").
+//! (docs/method.md §3.7, Sommer et al. 2020 eq. 8, Wang 2015), with a fixed ρ_c or one estimated online from
+//! the accelerated steps themselves ([`ChebyshevParams::auto_rho`]; docs/solvers.md, "Choosing ρ").
 
 use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
@@ -86,7 +86,7 @@ impl Chebyshev {
         } else if k == delay {
             match omega2_rule {
                 Omega2Rule::Chebyshev => 2.0 / (2.0 - rho * rho),
-                Omega2Rule::SeedLiteral => 4.0 / (4.0 - rho * rho),
+                Omega2Rule::Paper => 4.0 / (4.0 - rho * rho),
             }
         } else {
             4.0 / (4.0 - rho * rho * self.omega)
@@ -165,7 +165,7 @@ fn late_contraction(displacements: &[f64]) -> Option<f64> {
 }
 
 /// The contraction μ of the plain iteration that makes Chebyshev's iteration with parameter
-/// `rho_c` (< μ) contract at `rate` per iteration, in the linear model of ALGORITHM.md §5.4,
+/// `rho_c` (< μ) contract at `rate` per iteration, in the linear model of docs/method.md §5.4,
 /// as in the adaptive Chebyshev procedures of Hageman and Young (Applied Iterative Methods,
 /// 1981). Its slowest mode contracts at r = (μ + √(μ² − ρ_c²))/(1 + √(1 − ρ_c²)); with
 /// a = r·(1 + √(1 − ρ_c²)) that inverts to μ = (a² + ρ_c²)/(2a). A rate at or below what
@@ -196,7 +196,7 @@ mod tests {
 
     #[test]
     fn weights_follow_the_recurrence() {
-        let mut c = Chebyshev::new(params(0.925, 1, Omega2Rule::SeedLiteral));
+        let mut c = Chebyshev::new(params(0.925, 1, Omega2Rule::Paper));
         let w: Vec<f64> = (0..40).map(|k| c.next_weight(k)).collect();
         assert_eq!(w[0], 1.0);
         assert!((w[1] - 1.272).abs() < 1e-3, "{}", w[1]);
@@ -280,7 +280,7 @@ mod tests {
         let online = |rho| {
             Chebyshev::new(ChebyshevParams {
                 auto_rho: true,
-                ..params(rho, 1, Omega2Rule::SeedLiteral)
+                ..params(rho, 1, Omega2Rule::Paper)
             })
         };
         // Plain iteration contracts at 0.95 (the other modes faster, one alternating).
@@ -306,7 +306,7 @@ mod tests {
         // bring the displacement below 10⁻⁸ (123 against 287; plain iteration 360).
         let below = |d: Vec<f64>| d.iter().position(|&d| d < 1e-8).unwrap();
         let accelerated = below(displacements(&mut cheb, g, c, 1000));
-        let mut start = Chebyshev::new(params(0.6, 1, Omega2Rule::SeedLiteral));
+        let mut start = Chebyshev::new(params(0.6, 1, Omega2Rule::Paper));
         let from_start = below(displacements(&mut start, g, c, 1000));
         assert!(
             accelerated * 2 < from_start,
@@ -323,7 +323,7 @@ mod tests {
         assert!((0.55..0.65).contains(&cheb.rho()), "{}", cheb.rho());
 
         // A fixed ρ_c never changes.
-        let mut fixed = Chebyshev::new(params(0.85, 1, Omega2Rule::SeedLiteral));
+        let mut fixed = Chebyshev::new(params(0.85, 1, Omega2Rule::Paper));
         fixed.finish_step(&first);
         assert_eq!(fixed.rho(), 0.85);
     }

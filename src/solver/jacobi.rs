@@ -1,4 +1,4 @@
-//! Jacobi iteration x ← x + D⁻¹(b − Ax), matrix-free (ALGORITHM.md §3.6).
+//! Jacobi iteration x ← x + D⁻¹(b − Ax), matrix-free (docs/method.md §3.6).
 
 use super::{GlobalSolver, MAX_INNER_ITERATIONS, RESIDUAL_TOLERANCE, SystemMatrix};
 use crate::{Vec3, reduce};

@@ -1,4 +1,4 @@
-//! The global step of the local/global iteration (ALGORITHM.md §3): the system matrix and the
+//! The global step of the local/global iteration (docs/method.md §3): the system matrix and the
 //! linear solvers behind one trait, plus Chebyshev's extrapolation over the outer iterations.
 
 mod cg;
@@ -30,7 +30,7 @@ pub trait SystemMatrix: Sync {
     }
 }
 
-/// Formulation F1 (ALGORITHM.md §3.1): Â = diag(m + Δt²k(n_j + 1)), in kg.
+/// Formulation F1 (docs/method.md §3.1): Â = diag(m + Δt²k(n_j + 1)), in kg.
 #[derive(Clone, Debug, Default)]
 pub struct DiagonalSystem {
     /// Â_jj (kg).
@@ -68,7 +68,7 @@ pub trait GlobalSolver: Send + Sync {
     }
 }
 
-/// Relative residual ‖b − Ax‖ ≤ this·‖b‖ ends the converging solvers (ALGORITHM.md §3.4).
+/// Relative residual ‖b − Ax‖ ≤ this·‖b‖ ends the converging solvers (docs/method.md §3.4).
 pub const RESIDUAL_TOLERANCE: f64 = 1e-10;
 /// The converging solvers stop after this many inner iterations.
 pub const MAX_INNER_ITERATIONS: usize = 100;

@@ -1,0 +1,533 @@
+//! A closed tank of water left to settle: compression, residual motion, water height against
+//! N·V/area, and the pressure profile against ρ0·g·(H − y) (docs/method.md §10.1).
+//!
+//! Pressure. The density constraint has no pressure field, but its multiplier has the role of
+//! one. The force constraint i exerts on neighbour j at the converged iterate is
+//! f_ij = k·(P_ij − x_j) = k·λ_i·w_j·∇_{x_j}C_i = −k·λ_i·w_j·(m/ρ0)·∇W(x_i − x_j)
+//! (from M(x − s)/Δt² = k·Σ_i (P_i − x), the global step at its fixed point). The symmetric SPH
+//! pressure force particle i's pressure p_i exerts on j is m²·(p_i/ρ0²)·∇W(x_i − x_j). Equating
+//! the two gives p_i = −k·λ_i·w_j/V with V = m/ρ0; with w_j ≈ w_i = n_i + 1 this is the
+//! per-particle estimate p_i = −k·λ_i·(n_i + 1)/V used here, λ_i = −C_i/(|∇C_i|² + ε) being the
+//! local step's multiplier at the final positions. It is a reading of the constraint forces
+//! (their magnitude is set by the force balance, not by an equation of state), so it measures
+//! whether the constraints carry the weight of the water the way a pressure field would.
+//!
+//! Reading forces from positions needs a tighter solve than moving the water does. An iterate
+//! δ from the fixed point changes the global step's force on a particle by about
+//! (m + Δt²·k·w)·δ/Δt², at Δt = 5 ms and w = c = 33.5 about 1.4 times its weight per
+//! micrometre, so the τ = 3·10⁻⁴·r (7.5 µm) that keeps the tank at rest leaves the mean
+//! vertical constraint force at 1.3–1.9 times the weight. The
+//! pressure is therefore read over [`READING_WINDOW`] more seconds solved to
+//! [`READING_TOLERANCE_PER_RADIUS`]·r, after the motion and density have been measured.
+
+use crate::plot::{LineChart, Series, SeriesStyle};
+use projfluid::boundary::Aabb;
+use projfluid::{Error, Params, SolverKind, Vec3, World};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Length of the pressure reading after the free run (s).
+pub const READING_WINDOW: f64 = 0.25;
+/// τ of the pressure reading as a multiple of the particle radius: the force balance is
+/// within 3 % of the weight at 1e-5, 14 % off at 3e-5 (docs/validation.md).
+pub const READING_TOLERANCE_PER_RADIUS: f64 = 1e-5;
+
+/// How the tank is set up, how it is brought to its equilibrium and how long it then runs
+/// freely.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Setup {
+    /// Fluid lattice (x, y, z) in particles; y is up.
+    pub count: [usize; 3],
+    /// Particle radius r (m).
+    pub particle_radius: f64,
+    /// Relaxation time (s): the lattice is stepped this long with damped velocities
+    /// ([`World::relax`]) to find its equilibrium packing; 0 releases the lattice as built.
+    pub relax: f64,
+    /// Velocity damping rate of the relaxation (1/s).
+    pub damping: f64,
+    /// Free settling time after the relaxation (s): the measured part of the run.
+    pub settle: f64,
+    /// Global solver.
+    pub solver: SolverKind,
+    /// Use the calm settings ([`Params::calm`]) rather than the defaults.
+    pub calm: bool,
+    /// Outer stopping threshold τ (m); `None` for that of the settings chosen by `calm`.
+    pub tolerance: Option<f64>,
+    /// τ of the pressure reading (m); `None` for [`READING_TOLERANCE_PER_RADIUS`]·r.
+    pub reading_tolerance: Option<f64>,
+    /// Worker threads (0 = one per core).
+    pub threads: usize,
+}
+
+impl Default for Setup {
+    /// 12 × 16 × 12 particles of radius 0.025 m with the calm settings, relaxed for 10 s at
+    /// 4/s (every velocity scaled by ≈ 0.98 per 5 ms step), then settling freely for 2 s.
+    fn default() -> Self {
+        Self {
+            count: [12, 16, 12],
+            particle_radius: projfluid::params::DEFAULT_PARTICLE_RADIUS,
+            relax: 10.0,
+            damping: 4.0,
+            settle: 2.0,
+            solver: SolverKind::Chebyshev,
+            calm: true,
+            tolerance: None,
+            reading_tolerance: None,
+            threads: 0,
+        }
+    }
+}
+
+impl Setup {
+    /// Checks every field; the error names the bad one.
+    pub fn validate(&self) -> Result<(), Error> {
+        if self.count.iter().any(|&c| !(2..=100).contains(&c)) {
+            let c = format!("{:?}", self.count);
+            return Err(Error::invalid(
+                "count",
+                c,
+                "must lie between 2 and 100 per axis",
+            ));
+        }
+        if !(self.settle.is_finite() && self.settle > 0.0 && self.settle <= 60.0) {
+            return Err(Error::invalid(
+                "settle",
+                self.settle,
+                "must lie in (0, 60] seconds",
+            ));
+        }
+        if !(self.relax.is_finite() && (0.0..=60.0).contains(&self.relax)) {
+            return Err(Error::invalid(
+                "relax",
+                self.relax,
+                "must lie in [0, 60] seconds",
+            ));
+        }
+        if !(self.damping.is_finite() && self.damping >= 0.0) {
+            return Err(Error::invalid(
+                "damping",
+                self.damping,
+                "must be a non-negative finite rate (1/s)",
+            ));
+        }
+        for (name, tau) in [
+            ("tau", self.tolerance),
+            ("reading-tau", self.reading_tolerance),
+        ] {
+            if let Some(tau) = tau.filter(|t| !(t.is_finite() && *t > 0.0)) {
+                return Err(Error::invalid(
+                    name,
+                    tau,
+                    "must be a positive finite number of metres",
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// The tank at t = 0: the block at rest density (mass factor 1) with its centres one
+    /// spacing plus r/4 from the walls, and a lid well above it.
+    pub fn build(&self) -> Result<(World, Aabb), Error> {
+        self.validate()?;
+        let mut defaults = Params::with_radius(self.particle_radius);
+        if self.calm {
+            defaults = defaults.calm();
+        }
+        let params = Params {
+            mass_factor: 1.0,
+            solver: self.solver,
+            threads: self.threads,
+            displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),
+            ..defaults
+        };
+        let (r, d) = (params.particle_radius, params.spacing());
+        let mut world = World::new(params)?;
+        let gap = d + 0.25 * r;
+        let extent = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
+        let tank = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(
+                extent(self.count[0]),
+                1.5 * extent(self.count[1]),
+                extent(self.count[2]),
+            ),
+        };
+        world.add_container(tank, 1)?;
+        world.add_fluid_block(Vec3::repeat(gap), self.count, Vec3::zeros())?;
+        Ok((world, tank))
+    }
+}
+
+/// Mean estimated pressure of the particles in one horizontal layer of thickness d, over the
+/// steps of the last quarter second.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layer {
+    /// Mean height of the layer's particles above the floor plane (m).
+    pub height: f64,
+    /// Mean pressure estimate of its particles (Pa).
+    pub pressure: f64,
+    /// ρ0·g·(H − y) at the layer's centre (Pa).
+    pub hydrostatic: f64,
+    /// Particle samples averaged (particles times steps).
+    pub particles: usize,
+}
+
+/// What the settled tank shows.
+#[derive(Clone, Debug)]
+pub struct Report {
+    /// What was run.
+    pub setup: Setup,
+    /// Fluid particles.
+    pub particles: usize,
+    /// Lattice spacing d (m).
+    pub spacing: f64,
+    /// Average compression of the free run's last step (dimensionless).
+    pub density_error_avg: f64,
+    /// Largest compression of the free run's last step (dimensionless).
+    pub density_error_max: f64,
+    /// Largest per-step average compression over the free settling (dimensionless).
+    pub density_error_avg_worst: f64,
+    /// RMS speed at the end of the free run (m/s).
+    pub rms_velocity: f64,
+    /// Water height H above the floor plane: the mean top-layer centre plus d/2, less the
+    /// d/2 between the floor plane and the water's bottom face (m).
+    pub height: f64,
+    /// N·V/area with V = m/ρ0 and the area the water covers, (L_x − d)(L_z − d) (m).
+    pub expected_height: f64,
+    /// Fluid particles outside the tank or non-finite.
+    pub escaped: usize,
+    /// Outer stopping threshold τ of the pressure reading (m).
+    pub reading_tolerance: f64,
+    /// (height above the floor plane (m), pressure estimate (Pa)) of every particle after the
+    /// last step.
+    pub pressures: Vec<(f64, f64)>,
+    /// Layer means over particles at least one support radius from the side walls, averaged
+    /// over the steps of the reading window.
+    pub profile: Vec<Layer>,
+    /// Least-squares slope −dp/dy of the layer means at least one support radius from the
+    /// surface and the floor, where particle pressures under-read (Pa/m); ρ0·g for a
+    /// hydrostatic column.
+    pub slope: f64,
+    /// ρ0·g (Pa/m).
+    pub hydrostatic_slope: f64,
+    /// Pearson correlation of the layer means with ρ0·g·(H − y) over the same layers: the
+    /// shape of the profile, whatever its scale (1 for a linear profile).
+    pub shape_correlation: f64,
+    /// Mean vertical constraint force per particle, Σ_i k·(P_ij − x_j), evaluated at the end of
+    /// each step of the reading window, over the particle weight m·g: 1 when the constraints
+    /// are at the fixed point that holds the water up, larger when the outer iteration stopped
+    /// short of it.
+    pub force_balance: f64,
+}
+
+/// The water height in `tank` (m) and the height its volume N·V (V = m/ρ0) implies.
+///
+/// Wall particles keep fluid centres one spacing d from the wall planes and each particle owns
+/// a cube of edge d, so the fluid body ends d/2 from every wall: it fills (L_x − d)(L_z − d)
+/// and starts d/2 above the floor. The measured top is the mean height of the particles within
+/// d/2 of the highest one, plus d/2.
+pub fn water_height(world: &World, tank: &Aabb) -> (f64, f64) {
+    let d = world.params().spacing();
+    let positions = world.positions();
+    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let surface: Vec<f64> = positions
+        .iter()
+        .map(|p| p.y)
+        .filter(|&y| y > top - 0.5 * d)
+        .collect();
+    let surface_y = surface.iter().sum::<f64>() / surface.len().max(1) as f64 + 0.5 * d;
+    let height = surface_y - (tank.min.y + 0.5 * d);
+    let volume = world.fluid_count() as f64 * world.particle_mass() / world.params().rest_density;
+    let size = tank.max - tank.min;
+    (height, volume / ((size.x - d) * (size.z - d)))
+}
+
+/// Relaxes the tank for `setup.relax` seconds, lets it settle freely for `setup.settle`
+/// seconds and measures it, then reads the pressure over [`READING_WINDOW`] more seconds
+/// solved to `setup.reading_tolerance`; `progress` receives the fraction done as the run goes.
+pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
+    let (mut world, tank) = setup.build()?;
+    let end = setup.relax + setup.settle + READING_WINDOW;
+    // The relaxation in slices of at most a quarter second, for the progress report.
+    while setup.relax - world.time() > 1e-12 * setup.relax {
+        world.relax((setup.relax - world.time()).min(0.25), setup.damping)?;
+        progress(world.time() / end);
+    }
+    let mut worst: f64 = 0.0;
+    world.advance_with(setup.settle, |w| {
+        worst = worst.max(w.last_step().map_or(0.0, |s| s.density_error_avg));
+        progress(w.time() / end);
+        Ok(())
+    })?;
+    let (density_error_avg, density_error_max) = world
+        .last_step()
+        .map_or((0.0, 0.0), |s| (s.density_error_avg, s.density_error_max));
+    let rms_velocity = world.rms_velocity();
+    let (height, expected_height) = water_height(&world, &tank);
+    let escaped = world.escaped_count() + world.nan_count();
+
+    let d = world.params().spacing();
+    let h_support = world.params().support_radius();
+    let reading_tolerance = setup
+        .reading_tolerance
+        .unwrap_or(READING_TOLERANCE_PER_RADIUS * setup.particle_radius);
+    world.set_displacement_tolerance(reading_tolerance)?;
+    let inner = |p: &Vec3| {
+        p.x - tank.min.x >= h_support
+            && tank.max.x - p.x >= h_support
+            && p.z - tank.min.z >= h_support
+            && tank.max.z - p.z >= h_support
+    };
+    // Layer sums (pressure, height, particles) over the reading window: one step's
+    // multipliers are noisy.
+    let layers = ((tank.max.y - tank.min.y) / d).ceil() as usize + 1;
+    let mut sums = vec![(0.0, 0.0, 0usize); layers];
+    let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
+    let mut estimates = Vec::new();
+    world.advance_with(READING_WINDOW, |w| {
+        let support;
+        let pressures = w.constraint_pressures();
+        (estimates, support) = (pressures.samples, pressures.mean_vertical_force);
+        for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
+            let y = p.y - tank.min.y;
+            let i = ((y / d).max(0.0) as usize).min(layers - 1);
+            sums[i].0 += v;
+            sums[i].1 += y;
+            sums[i].2 += 1;
+        }
+        support_sum += support;
+        sampled_steps += 1;
+        progress(w.time() / end);
+        Ok(())
+    })?;
+    let rho0 = world.params().rest_density;
+    let g = Vec3::from(world.params().gravity).norm();
+    let floor = tank.min.y;
+
+    let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
+    let support = support_sum / sampled_steps.max(1) as f64;
+    // The water's top face is the pressure datum: H above the floor plane is height + d/2.
+    let datum = height + 0.5 * d;
+    let profile: Vec<Layer> = sums
+        .iter()
+        .filter(|s| s.2 > 0)
+        .map(|s| {
+            let y = s.1 / s.2 as f64;
+            Layer {
+                height: y,
+                pressure: s.0 / s.2 as f64,
+                hydrostatic: rho0 * g * (datum - y),
+                particles: s.2,
+            }
+        })
+        .collect();
+    let fitted: Vec<(f64, f64)> = profile
+        .iter()
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
+        .map(|l| (l.height, l.pressure))
+        .collect();
+    let shape: Vec<(f64, f64)> = profile
+        .iter()
+        .filter(|l| l.height >= h_support && l.height <= datum - h_support)
+        .map(|l| (l.pressure, l.hydrostatic))
+        .collect();
+    Ok(Report {
+        setup: setup.clone(),
+        particles: world.fluid_count(),
+        spacing: d,
+        density_error_avg,
+        density_error_max,
+        density_error_avg_worst: worst,
+        rms_velocity,
+        height,
+        expected_height,
+        escaped,
+        reading_tolerance,
+        pressures,
+        profile,
+        slope: -least_squares_slope(&fitted),
+        shape_correlation: correlation(&shape),
+        hydrostatic_slope: rho0 * g,
+        force_balance: support / (world.particle_mass() * g),
+    })
+}
+
+/// Pearson correlation of the pairs (NaN for fewer than two distinct values).
+fn correlation(pairs: &[(f64, f64)]) -> f64 {
+    let n = pairs.len() as f64;
+    let (ma, mb) = pairs
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let cov: f64 = pairs.iter().map(|p| (p.0 - ma) * (p.1 - mb)).sum();
+    let va: f64 = pairs.iter().map(|p| (p.0 - ma).powi(2)).sum();
+    let vb: f64 = pairs.iter().map(|p| (p.1 - mb).powi(2)).sum();
+    cov / (va * vb).sqrt()
+}
+
+/// Slope of the least-squares line through `points` (NaN for fewer than two x values).
+fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
+    let n = points.len() as f64;
+    let (mx, my) = points
+        .iter()
+        .fold((0.0, 0.0), |(a, b), p| (a + p.0 / n, b + p.1 / n));
+    let sxy: f64 = points.iter().map(|p| (p.0 - mx) * (p.1 - my)).sum();
+    let sxx: f64 = points.iter().map(|p| (p.0 - mx).powi(2)).sum();
+    sxy / sxx
+}
+
+impl Report {
+    /// A plain-text report of every measured quantity.
+    pub fn text(&self) -> String {
+        let mut out = String::new();
+        let s = &self.setup;
+        let _ = writeln!(
+            out,
+            "tank at rest: {} particles ({}x{}x{}, r = {} m), relaxed {} s at damping {}/s, \
+             then {} s free; {} solver, {} settings",
+            self.particles,
+            s.count[0],
+            s.count[1],
+            s.count[2],
+            s.particle_radius,
+            s.relax,
+            s.damping,
+            s.settle,
+            s.solver.name(),
+            if s.calm { "calm" } else { "default" }
+        );
+        let rows = [
+            (
+                "density error (last step)",
+                format!(
+                    "avg {:.4} %, max {:.3} % (compression only)",
+                    100.0 * self.density_error_avg,
+                    100.0 * self.density_error_max
+                ),
+            ),
+            (
+                "density error (worst step avg)",
+                format!("{:.4} %", 100.0 * self.density_error_avg_worst),
+            ),
+            (
+                "rms velocity after the free run",
+                format!("{:.4} m/s", self.rms_velocity),
+            ),
+            (
+                "water height",
+                format!(
+                    "{:.4} m, N·V/area gives {:.4} m ({:+.2} spacings)",
+                    self.height,
+                    self.expected_height,
+                    (self.height - self.expected_height) / self.spacing
+                ),
+            ),
+            (
+                "pressure slope -dp/dy",
+                format!(
+                    "{:.0} Pa/m, rho0·g = {:.0} Pa/m ({:+.1} %)",
+                    self.slope,
+                    self.hydrostatic_slope,
+                    100.0 * (self.slope / self.hydrostatic_slope - 1.0)
+                ),
+            ),
+            (
+                "pressure shape correlation",
+                format!(
+                    "{:.3} with rho0·g·(H - y) (1 = linear)",
+                    self.shape_correlation
+                ),
+            ),
+            (
+                "constraint force / weight",
+                format!("{:.3} (1 at the fixed point)", self.force_balance),
+            ),
+            (
+                "pressure read at",
+                format!(
+                    "tau = {:.1e} m over the {READING_WINDOW} s after the free run",
+                    self.reading_tolerance
+                ),
+            ),
+            ("escaped or NaN particles", self.escaped.to_string()),
+        ];
+        for (k, v) in rows {
+            let _ = writeln!(out, "{k:<32} {v}");
+        }
+        let _ = writeln!(
+            out,
+            "\npressure by layer (particles at least one support radius from the side walls)"
+        );
+        let _ = writeln!(
+            out,
+            "{:>8}  {:>10}  {:>16}  {:>6}",
+            "y (m)", "p (Pa)", "rho0 g (H-y) (Pa)", "count"
+        );
+        for l in &self.profile {
+            let _ = writeln!(
+                out,
+                "{:>8.3}  {:>10.1}  {:>16.1}  {:>6}",
+                l.height, l.pressure, l.hydrostatic, l.particles
+            );
+        }
+        out
+    }
+}
+
+/// The files [`write_report`] writes.
+#[derive(Clone, Debug)]
+pub struct ReportFiles {
+    /// Layer profile as CSV.
+    pub profile_csv: PathBuf,
+    /// Pressure chart.
+    pub pressure_png: PathBuf,
+}
+
+/// Writes the layer profile (CSV) and the pressure chart (PNG) into `dir` (which must exist).
+pub fn write_report(dir: &Path, report: &Report) -> Result<ReportFiles, Error> {
+    let files = ReportFiles {
+        profile_csv: dir.join("hydrostatic_profile.csv"),
+        pressure_png: dir.join("hydrostatic_pressure.png"),
+    };
+    let mut csv = String::from("height_m,pressure_pa,hydrostatic_pa,particles\n");
+    for l in &report.profile {
+        let _ = writeln!(
+            csv,
+            "{},{},{},{}",
+            l.height, l.pressure, l.hydrostatic, l.particles
+        );
+    }
+    super::write_text(&files.profile_csv, &csv)?;
+    let series = vec![
+        Series {
+            label: "every particle".into(),
+            points: report.pressures.clone(),
+            style: SeriesStyle::Markers,
+        },
+        Series {
+            label: "layer mean, away from side walls".into(),
+            points: report
+                .profile
+                .iter()
+                .map(|l| (l.height, l.pressure))
+                .collect(),
+            style: SeriesStyle::LineMarkers,
+        },
+        Series {
+            label: "ρ0·g·(H − y)".into(),
+            points: report
+                .profile
+                .iter()
+                .map(|l| (l.height, l.hydrostatic))
+                .collect(),
+            style: SeriesStyle::Line,
+        },
+    ];
+    LineChart {
+        title: "Tank at rest: constraint pressure against hydrostatics".into(),
+        x_label: "height above the floor y (m)".into(),
+        y_label: "pressure (Pa)".into(),
+        series,
+    }
+    .write_png(&files.pressure_png)?;
+    Ok(files)
+}

@@ -1,0 +1,389 @@
+//! Validation against experiment: the Martin & Moyce (1952) column collapse at a coarse
+//! resolution, a tank at rest, and the `projfluid validate` command line.
+
+use projfluid::SolverKind;
+use projfluid_lab::validation::hydrostatic;
+use projfluid_lab::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
+use projfluid_lab::validation::reference::Measurements;
+use std::path::PathBuf;
+use std::process::Command;
+use std::sync::OnceLock;
+
+/// Particles across the column width a in the tests (the CLI default is 20).
+const TEST_RESOLUTION: usize = 16;
+
+/// The n² = 2 collapse with `solver` at the test resolution, compared with Tables 2 and 6.
+fn collapse(solver: SolverKind) -> (martin_moyce::Run, Comparison) {
+    let setup = Setup {
+        particles_across: TEST_RESOLUTION,
+        solver,
+        ..Setup::new(2)
+    };
+    let run = martin_moyce::simulate(&setup, |_| {}).expect("collapse runs");
+    let data = Measurements::for_ratio(2).unwrap();
+    let cmp = martin_moyce::compare(&run, &data).expect("front reaches Z = 1.44");
+    (run, cmp)
+}
+
+/// Alignment: the simulated times are shifted so that the simulated front reaches Z = 1.44 at
+/// the measured T = 1.19 (the experiment's dam took a finite time to remove, so its early
+/// front lags). Then at every tabulated T (Table 2, T = 0.41 … 3.33) the front must lie within
+/// 10 % of the measured Z, and at every tabulated τ the run covers (Table 6, unshifted: the
+/// measured heights show no lag) the residual height within 10 % of the measured H.
+fn assert_matches_martin_moyce(solver: SolverKind) {
+    let (run, cmp) = collapse(solver);
+    assert_eq!(run.escaped, 0);
+    assert!(
+        run.density_error_max() < 0.01,
+        "compression {}",
+        run.density_error_max()
+    );
+    let a = cmp.alignment;
+    assert_eq!(
+        a.measured, 1.19,
+        "Table 2 reaches Z = {ALIGNMENT_LEVEL} at T = 1.19"
+    );
+    // The shift itself is bounded: a fluid that is far too fast or slow cannot hide in it.
+    assert!(
+        (0.0..0.5).contains(&a.shift),
+        "alignment shift {:+.3} in T (simulated front at Z = 1.44 at T = {:.3})",
+        a.shift,
+        a.simulated
+    );
+    assert_eq!(cmp.front.len(), 15);
+    assert!(
+        cmp.front.iter().all(|r| r.simulated.is_some()),
+        "the run must cover every tabulated T"
+    );
+    assert_within_10_percent(solver, "front at T", "Z", &cmp.front);
+    let compared: Vec<Row> = cmp
+        .height
+        .iter()
+        .filter(|r| r.simulated.is_some())
+        .copied()
+        .collect();
+    assert!(
+        compared.len() >= 12,
+        "only {} heights compared",
+        compared.len()
+    );
+    assert_within_10_percent(solver, "residual height at tau", "H", &compared);
+}
+
+/// Every simulated row of `rows` within 10 % of the measurement.
+fn assert_within_10_percent(solver: SolverKind, what: &str, symbol: &str, rows: &[Row]) {
+    for row in rows {
+        let (Some(sim), Some(err)) = (row.simulated, row.relative_error()) else {
+            continue;
+        };
+        assert!(
+            err.abs() <= 0.10,
+            "{}: {what} = {}: {symbol} = {sim:.3} simulated, {} measured ({:+.1} %)",
+            solver.name(),
+            row.time,
+            row.measured,
+            100.0 * err
+        );
+    }
+}
+
+#[test]
+fn collapse_matches_martin_moyce_with_the_default_solver() {
+    assert_matches_martin_moyce(SolverKind::Chebyshev);
+}
+
+#[test]
+fn collapse_matches_martin_moyce_with_jacobi1() {
+    assert_matches_martin_moyce(SolverKind::Jacobi1);
+}
+
+/// One settled tank shared by the hydrostatic tests: 8 × 12 × 8 particles with the calm
+/// settings, relaxed for 10 s, then 2 s free, then the pressure reading (the defaults of
+/// `hydrostatic::Setup`).
+fn settled_tank() -> &'static hydrostatic::Report {
+    static REPORT: OnceLock<hydrostatic::Report> = OnceLock::new();
+    REPORT.get_or_init(|| {
+        let setup = hydrostatic::Setup {
+            count: [8, 12, 8],
+            ..hydrostatic::Setup::default()
+        };
+        hydrostatic::simulate(&setup, |_| {}).expect("tank settles")
+    })
+}
+
+/// The settled tank is contained, compressed by at most 0.1 % on average (every step), and
+/// as high as its volume N·V over the covered area says (within one spacing).
+#[test]
+fn tank_at_rest_keeps_density_and_height() {
+    let r = settled_tank();
+    assert_eq!(r.escaped, 0);
+    assert!(
+        r.density_error_avg <= 1e-3,
+        "{:.4} %",
+        100.0 * r.density_error_avg
+    );
+    assert!(
+        r.density_error_avg_worst <= 1e-3,
+        "{:.4} %",
+        100.0 * r.density_error_avg_worst
+    );
+    assert!(
+        (r.height - r.expected_height).abs() <= r.spacing,
+        "height {:.4} m, N·V/area {:.4} m",
+        r.height,
+        r.expected_height
+    );
+}
+
+/// The pressure read from the constraint multipliers grows linearly with depth, like
+/// ρ0·g·(H − y), more than one support radius from the surface and the floor.
+#[test]
+fn tank_at_rest_pressure_has_the_hydrostatic_shape() {
+    let r = settled_tank();
+    assert!(r.profile.len() >= 8, "{} layers", r.profile.len());
+    assert!(
+        r.shape_correlation >= 0.95,
+        "correlation {:.3} with rho0 g (H - y)\n{}",
+        r.shape_correlation,
+        r.text()
+    );
+    assert!(
+        r.slope > 0.0,
+        "pressure must grow with depth, slope {}",
+        r.slope
+    );
+}
+
+/// The pressure read from the constraint multipliers has the hydrostatic magnitude: slope
+/// −dp/dy within 10 % of ρ0·g, and the constraints carry the water's weight (mean vertical
+/// constraint force within 10 % of m·g).
+#[test]
+fn tank_at_rest_pressure_has_the_hydrostatic_magnitude() {
+    let r = settled_tank();
+    let ratio = r.slope / r.hydrostatic_slope;
+    assert!(
+        (ratio - 1.0).abs() <= 0.10,
+        "slope {:.0} Pa/m = {ratio:.2} rho0 g; constraint force/weight {:.2}",
+        r.slope,
+        r.force_balance
+    );
+    assert!(
+        (r.force_balance - 1.0).abs() <= 0.10,
+        "constraint force/weight {:.3}",
+        r.force_balance
+    );
+}
+
+/// The tank comes to rest: RMS velocity below 1 cm/s after 2 s of free settling.
+#[test]
+fn tank_at_rest_comes_to_rest() {
+    let r = settled_tank();
+    assert!(
+        r.rms_velocity < 0.01,
+        "rms velocity {} m/s after 2 s",
+        r.rms_velocity
+    );
+}
+
+fn projfluid(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_projfluid"))
+        .args(args)
+        .output()
+        .expect("run projfluid")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("validation")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn cli_martin_moyce_writes_its_table_csv_and_png() {
+    let dir = scratch("cli");
+    let out = projfluid(&[
+        "validate",
+        "martin-moyce",
+        "--resolution",
+        "6",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(stdout.contains("time alignment"), "{stdout}");
+    assert!(stdout.contains("shifted by"), "{stdout}");
+    assert!(
+        stdout.contains("  3.330  "),
+        "the T = 3.33 row is missing:\n{stdout}"
+    );
+    for name in ["series.csv", "comparison.csv", "front.png", "height.png"] {
+        let path = dir.join(format!("martin_moyce_n2-2_{name}"));
+        let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        if name.ends_with(".png") {
+            assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{name} is not a PNG");
+        } else {
+            let text = String::from_utf8(bytes).unwrap();
+            assert!(text.lines().count() > 15, "{name}:\n{text}");
+        }
+    }
+    let csv = std::fs::read_to_string(dir.join("martin_moyce_n2-2_comparison.csv")).unwrap();
+    assert!(
+        csv.lines().any(|l| l.starts_with("front,3.33,4.11,")),
+        "{csv}"
+    );
+}
+
+#[test]
+fn cli_validate_rejects_bad_options_with_exit_code_2() {
+    let dir = scratch("bad");
+    let out_dir = dir.to_str().unwrap();
+    let cases: [&[&str]; 11] = [
+        &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
+        &[
+            "validate",
+            "martin-moyce",
+            "--resolution",
+            "2",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "martin-moyce",
+            "--duration",
+            "-1",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "martin-moyce",
+            "--solver",
+            "magic",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "hydrostatic",
+            "--count",
+            "1,5,5",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "hydrostatic",
+            "--count",
+            "5,5",
+            "--out",
+            out_dir,
+        ],
+        &["validate", "hydrostatic", "--tau", "0", "--out", out_dir],
+        &["validate", "hydrostatic", "--relax", "-1", "--out", out_dir],
+        &[
+            "validate",
+            "hydrostatic",
+            "--damping",
+            "nan",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "hydrostatic",
+            "--settings",
+            "loud",
+            "--out",
+            out_dir,
+        ],
+        &["validate", "nonsense"],
+    ];
+    for args in cases {
+        let out = projfluid(args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains("error"), "{args:?}: {stderr}");
+    }
+    // The message names the option.
+    let out = projfluid(cases[1]);
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--resolution"));
+    assert!(
+        !dir.exists(),
+        "a rejected command must not create its output directory"
+    );
+}
+
+#[test]
+fn cli_hydrostatic_writes_its_profile_and_chart() {
+    let dir = scratch("cli_hydrostatic");
+    let out = projfluid(&[
+        "validate",
+        "hydrostatic",
+        "--count",
+        "4,5,4",
+        "--relax",
+        "0.5",
+        "--settle",
+        "0.1",
+        "--settings",
+        "default",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in [
+        "density error",
+        "rms velocity",
+        "N·V/area",
+        "pressure slope",
+        "force / weight",
+        "relaxed 0.5 s at damping 4/s, then 0.1 s free",
+        "default settings",
+    ] {
+        assert!(stdout.contains(key), "`{key}` missing:\n{stdout}");
+    }
+    let png = std::fs::read(dir.join("hydrostatic_pressure.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let csv = std::fs::read_to_string(dir.join("hydrostatic_profile.csv")).unwrap();
+    assert!(
+        csv.starts_with("height_m,pressure_pa,hydrostatic_pa,particles\n"),
+        "{csv}"
+    );
+}
+
+#[test]
+fn cli_validate_exits_1_when_the_output_cannot_be_written() {
+    let dir = scratch("blocked");
+    std::fs::create_dir_all(&dir).unwrap();
+    let blocker = dir.join("file");
+    std::fs::write(&blocker, "not a directory").unwrap();
+    let out = projfluid(&[
+        "validate",
+        "martin-moyce",
+        "--resolution",
+        "4",
+        "--out",
+        blocker.join("sub").to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("cannot create output directory"),
+        "{stderr}"
+    );
+}

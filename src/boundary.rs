@@ -7,10 +7,12 @@ use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid}
 use rayon::prelude::*;
 
 pub mod mesh;
+mod particles;
 pub mod shapes;
 pub mod transform;
 pub mod winding;
 
+pub(crate) use particles::Boundary;
 pub use transform::Transform;
 
 /// An axis-aligned box, corners in metres.

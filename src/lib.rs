@@ -15,9 +15,12 @@
 //! Units are SI throughout: metres, seconds, kilograms.
 
 pub mod boundary;
+pub mod checkpoint;
 pub mod constraint;
 mod error;
 pub mod ffi;
+mod fluid;
+mod forces;
 pub mod io;
 pub mod kernel;
 pub mod neighbors;
@@ -31,17 +34,11 @@ pub mod solver;
 pub mod stats;
 mod step;
 mod world;
+mod xsph;
 
 pub use error::Error;
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
-pub use world::World;
+pub use world::{GridParts, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).
 pub type Vec3 = nalgebra::Vector3<f64>;
-
-impl World {
-    /// Worker threads of the world's pool.
-    pub fn thread_count(&self) -> usize {
-        self.pool.current_num_threads()
-    }
-}

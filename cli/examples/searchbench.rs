@@ -15,7 +15,7 @@ fn main() {
         std::process::exit(2);
     }
     let checkpoint = std::path::Path::new(&a[0]);
-    let world = projfluid::io::checkpoint::read_checkpoint(checkpoint, Some(1))
+    let world = projfluid::checkpoint::read_checkpoint(checkpoint, Some(1))
         .expect("checkpoint")
         .world;
     let repetitions: usize = a[1].parse().expect("repetitions");

@@ -1,6 +1,5 @@
-//! Readers and writers: VTK and PLY frames, OBJ meshes, checkpoints.
+//! Readers and writers: VTK and PLY frames, OBJ meshes.
 
-pub mod checkpoint;
 pub mod obj;
 pub mod ply;
 pub mod vtk;

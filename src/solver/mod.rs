@@ -5,11 +5,13 @@ mod cg;
 mod chebyshev;
 mod jacobi;
 mod ldlt;
+mod sweep;
 
 pub use cg::Cg;
 pub use chebyshev::{Chebyshev, OnlineRho};
 pub use jacobi::Jacobi;
 pub use ldlt::Ldlt;
+pub use sweep::Sweep;
 
 use crate::Vec3;
 use crate::params::SolverKind;

@@ -4,7 +4,7 @@ use crate::frames::{FrameFormat, Frames};
 use crate::{Failure, RhoArg, rho_parser, solver_parser};
 use clap::Args;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use projfluid::io::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
+use projfluid::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
 use projfluid::scene::Scene;
 use projfluid::{Error, SolverKind};
 use projfluid_lab::driver::{self, RunError, RunLength, StepReport};

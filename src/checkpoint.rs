@@ -1,10 +1,8 @@
 //! Checkpoints: the complete state of a run in one file, so that a resumed run continues
 //! bit for bit as if it had never stopped.
 //!
-//! Besides positions, velocities and time, the step depends on the storage order of the
-//! particles (the counting sort is stable, and the order decides the order of floating-point
-//! sums), on the neighbour grid (its origin decides the cells, hence the sort) and on the
-//! boundary particles in their sorted order. All of these are stored as they are.
+//! A checkpoint holds the world's exact state ([`WorldState`]) and the scene it was built
+//! from, with the world's parameters.
 //!
 //! Layout: the magic `PFCHECK1`; the length (u64, little-endian) of a JSON header, the
 //! header (the scene with the world's parameters, time, step count, next Δt, containers,
@@ -14,10 +12,9 @@
 //! truncated file is refused.
 
 use crate::boundary::Aabb;
-use crate::neighbors::UniformGrid;
 use crate::scene::Scene;
 use crate::solver::OnlineRho;
-use crate::{Error, Vec3, World};
+use crate::{Error, GridParts, Vec3, World, WorldState};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
@@ -64,15 +61,6 @@ struct Header {
     chebyshev: OnlineRho,
 }
 
-/// The neighbour grid, as [`UniformGrid::parts`].
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct GridParts {
-    origin: [f64; 3],
-    cell_size: f64,
-    dims: [usize; 3],
-}
-
 /// Writes a checkpoint of `world`, which was built from `scene`, to `path` (through a
 /// temporary file renamed into place, so that an interrupted write never leaves a partial
 /// checkpoint under that name). `run_end` records where the run was going to stop.
@@ -83,37 +71,31 @@ pub fn write_checkpoint(
     run_end: Option<RunEnd>,
 ) -> Result<(), Error> {
     let mut scene = scene.clone();
-    scene.params = world.params.clone();
+    scene.params = world.params().clone();
+    let state = world.export_state();
     let header = Header {
         scene: scene.to_json(),
-        time: world.time,
-        steps: world.steps,
-        next_dt: world.next_dt,
-        containers: world
+        time: state.time,
+        steps: state.steps,
+        next_dt: state.next_dt,
+        containers: state
             .containers
             .iter()
             .map(|c| [c.min.into(), c.max.into()])
             .collect(),
-        grid: world.grid.as_ref().map(|g| {
-            let (origin, cell_size, dims) = g.parts();
-            GridParts {
-                origin: origin.into(),
-                cell_size,
-                dims,
-            }
-        }),
-        grid_capped: world.grid_capped,
-        boundary_dirty: world.boundary.dirty,
-        fluid_count: world.fluid.positions.len(),
-        boundary_count: world.boundary.positions.len(),
+        grid: state.grid,
+        grid_capped: state.grid_capped,
+        boundary_dirty: !state.boundary_sorted,
+        fluid_count: state.positions.len(),
+        boundary_count: state.boundary_positions.len(),
         run_end,
-        chebyshev: world.chebyshev.online(),
+        chebyshev: state.online_rho,
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
-    let f = &world.fluid;
+    let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 60 + world.boundary.positions.len() * 24,
+        64 + json.len() + f.positions.len() * 60 + f.boundary_positions.len() * 24,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
@@ -127,7 +109,7 @@ pub fn write_checkpoint(
     for id in &f.ids {
         bytes.extend_from_slice(&id.to_le_bytes());
     }
-    for p in &world.boundary.positions {
+    for p in &f.boundary_positions {
         push_vec3(&mut bytes, p);
     }
     let digest = Sha256::digest(&bytes);
@@ -205,45 +187,32 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
     let ids: Vec<u32> = (0..n).map(|_| u32::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
-    let mut seen = vec![false; n];
-    for &id in &ids {
-        match seen.get_mut(id as usize) {
-            Some(s) if !*s => *s = true,
-            _ => return Err(bad("is inconsistent: the particle ids are not 0..n")),
-        }
-    }
-
-    let mut world = World::new(scene.params.clone())?;
-    world.add_fluid_particles(&positions, Some(&velocities))?;
-    world.add_boundary_particles(&boundary)?;
-    world.fluid.densities = densities;
-    world.fluid.ids = ids;
-    world.containers = header
-        .containers
-        .iter()
-        .map(|[min, max]| Aabb {
-            min: Vec3::from(*min),
-            max: Vec3::from(*max),
-        })
-        .collect();
-    world.time = header.time;
-    world.steps = header.steps;
-    world.next_dt = header.next_dt;
-    world.chebyshev.set_online(header.chebyshev);
-    world.grid_capped = header.grid_capped;
-    world.grid = match header.grid {
-        None => None,
-        Some(g) => Some(
-            UniformGrid::from_parts_checked(Vec3::from(g.origin), g.cell_size, g.dims)
-                .ok_or_else(|| bad("is inconsistent: its neighbour grid is invalid"))?,
-        ),
+    let state = WorldState {
+        time: header.time,
+        steps: header.steps,
+        next_dt: header.next_dt,
+        positions,
+        velocities,
+        densities,
+        ids,
+        boundary_positions: boundary,
+        boundary_sorted: !header.boundary_dirty,
+        containers: header
+            .containers
+            .iter()
+            .map(|[min, max]| Aabb {
+                min: Vec3::from(*min),
+                max: Vec3::from(*max),
+            })
+            .collect(),
+        grid: header.grid,
+        grid_capped: header.grid_capped,
+        online_rho: header.chebyshev,
     };
-    // The boundary was saved in its sorted order: sorting again keeps that order and
-    // recomputes the same volumes.
-    world.boundary.dirty = header.boundary_dirty || world.grid.is_none();
-    if !world.boundary.dirty {
-        world.sort_boundary();
-    }
+    let mut world = World::new(scene.params.clone())?;
+    world
+        .import_state(state)
+        .map_err(|e| bad(&format!("is inconsistent: {e}")))?;
     Ok(Checkpoint {
         scene,
         world,

@@ -1,0 +1,38 @@
+//! One Jacobi sweep on the diagonal system fused with Chebyshev's extrapolation and the
+//! displacement measure, so that a single-sweep solver costs one pass over the particles
+//! (docs/method.md §3.6, §3.7).
+
+use super::Chebyshev;
+use crate::{Vec3, reduce};
+
+/// The global step of a solver that is one Jacobi sweep on the diagonal system, fused with
+/// Chebyshev's extrapolation and the displacement, for the particles of one chunk.
+pub struct Sweep<'a> {
+    /// Â_jj (kg).
+    pub diagonal: &'a [f64],
+    /// X^(k) (m).
+    pub current: &'a [Vec3],
+    /// X^(k−1) (m).
+    pub previous: &'a [Vec3],
+    /// The recurrence and its weight ω, when the extrapolation changes the iterate.
+    pub chebyshev: Option<(&'a Chebyshev, f64)>,
+}
+
+impl Sweep<'_> {
+    /// Writes X^(k+1)_j for the particles `first..` of the right-hand sides `rhs` (kg·m) into
+    /// `next` (m): the sweep X_j + (b_j − Â_jj·X_j)/Â_jj, bitwise as [`super::Jacobi`]
+    /// computes it, then extrapolated. Returns max_j |X^(k+1)_j − X^(k)_j| (m) over the chunk.
+    pub fn apply(&self, first: usize, rhs: &[Vec3], next: &mut [Vec3]) -> f64 {
+        let mut largest = f64::NEG_INFINITY;
+        for (j, (b, next)) in (first..).zip(rhs.iter().zip(next)) {
+            let (x, d) = (self.current[j], self.diagonal[j]);
+            let mut plain = x + (b - x * d) / d;
+            if let Some((chebyshev, omega)) = self.chebyshev {
+                plain = chebyshev.extrapolated(omega, plain, x, self.previous[j]);
+            }
+            *next = plain;
+            largest = reduce::nan_max(largest, (plain - x).norm());
+        }
+        largest
+    }
+}

@@ -1,0 +1,79 @@
+//! The end of a step (docs/method.md §1.3): velocities from the positions, the new
+//! positions, densities at them, the non-pressure forces, and the step's statistics.
+
+use super::StepBuffers;
+use super::iterate::Outcome;
+use crate::boundary::Boundary;
+use crate::constraint::{DensityConstraint, Neighborhood};
+use crate::fluid::Fluid;
+use crate::forces::NonPressureForce;
+use crate::params::Params;
+use crate::reduce;
+use crate::stats::{StepStats, StepTimings};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// What the end of a step reads besides the fluid and the buffers.
+pub(super) struct Finish<'a> {
+    pub params: &'a Params,
+    pub constraint: &'a DensityConstraint,
+    pub boundary: &'a Boundary,
+    pub forces: &'a mut [Box<dyn NonPressureForce>],
+    /// Step size (s).
+    pub dt: f64,
+}
+
+/// Moves the fluid to the iteration's result X^(k) (in `b.current`), with v = (x^{n+1} −
+/// x^n)/Δt, evaluates the densities, applies the non-pressure forces and measures the step.
+pub(super) fn finish(
+    f: Finish,
+    fluid: &mut Fluid,
+    b: &mut StepBuffers,
+    outcome: Outcome,
+    timings: &mut StepTimings,
+) -> StepStats {
+    let Finish {
+        params,
+        constraint,
+        boundary,
+        forces,
+        dt,
+    } = f;
+    let t = Instant::now();
+    fluid
+        .velocities
+        .par_iter_mut()
+        .zip(b.current.par_iter().zip(fluid.positions.par_iter()))
+        .for_each(|(v, (new, old))| *v = (new - old) / dt);
+    std::mem::swap(&mut fluid.positions, &mut b.current);
+
+    // Densities at the new positions with the step's neighbour lists, then the forces.
+    let nb = Neighborhood {
+        fluid: &b.fluid_lists,
+        boundary: &b.boundary_lists,
+        boundary_positions: &boundary.positions,
+        boundary_psi: &boundary.psi,
+        weights: &b.weights,
+    };
+    constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
+    for force in forces.iter_mut() {
+        force.apply(constraint, &nb, fluid, &mut b.next);
+    }
+    let rest = constraint.rest_density;
+    let errors = |rho: &f64| (rho / rest - 1.0).max(0.0);
+    let n = fluid.densities.len() as f64;
+    let density_error_avg = reduce::sum(&fluid.densities, errors) / n;
+    let density_error_max = reduce::max(&fluid.densities, errors);
+    timings.rest = t.elapsed().as_secs_f64();
+    StepStats {
+        dt,
+        outer_iterations: outcome.outer,
+        inner_iterations: outcome.inner,
+        hit_max_iterations: outcome.displacement >= params.displacement_tolerance,
+        rho: outcome.rho,
+        last_displacement: outcome.displacement,
+        density_error_avg,
+        density_error_max,
+        timings: *timings,
+    }
+}

@@ -1,0 +1,160 @@
+//! The outer local/global iteration of a step (docs/method.md §1.3, §3, §4): the system
+//! matrix of formulation F1 frozen for the step, then local projections and global solves
+//! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until no particle moved farther
+//! than τ.
+
+use super::StepBuffers;
+use crate::boundary::Boundary;
+use crate::constraint::{CHUNK, DensityConstraint, Neighborhood};
+use crate::params::{Params, SolverKind};
+use crate::solver::{Chebyshev, GlobalSolver, Sweep};
+use crate::stats::StepTimings;
+use crate::{Vec3, reduce};
+use rayon::prelude::*;
+use std::time::Instant;
+
+/// What the iteration reads besides the buffers.
+pub(super) struct Iteration<'a> {
+    pub params: &'a Params,
+    pub constraint: &'a DensityConstraint,
+    pub boundary: &'a Boundary,
+    pub solver: &'a mut dyn GlobalSolver,
+    pub chebyshev: &'a mut Chebyshev,
+    /// Step size (s).
+    pub dt: f64,
+}
+
+/// How the iteration ended.
+pub(super) struct Outcome {
+    /// Outer iterations taken.
+    pub outer: usize,
+    /// Inner iterations of the linear solver, summed over the outer ones.
+    pub inner: usize,
+    /// Largest displacement of the last outer iteration (m).
+    pub displacement: f64,
+    /// Chebyshev's ρ_c in this step (0 without extrapolation).
+    pub rho: f64,
+}
+
+/// Iterates until the displacement rule or the iteration limit stops; the result X^(k) is
+/// left in `b.current`. Adds the local and global times to `timings`.
+pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimings) -> Outcome {
+    let Iteration {
+        params,
+        constraint,
+        boundary,
+        solver,
+        chebyshev,
+        dt,
+    } = it;
+    // The system matrix of formulation F1, frozen for the step.
+    let mass = constraint.mass;
+    let dt2k = dt * dt * params.stiffness;
+    let lists = &b.fluid_lists;
+    b.system.diagonal.resize(lists.len(), 0.0);
+    b.system
+        .diagonal
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
+    solver.prepare(&b.system);
+
+    b.previous.clone_from(&b.current);
+    b.next.resize(b.current.len(), Vec3::zeros());
+    constraint.weights(&b.fluid_lists, &mut b.weights);
+    let nb = Neighborhood {
+        fluid: &b.fluid_lists,
+        boundary: &b.boundary_lists,
+        boundary_positions: &boundary.positions,
+        boundary_psi: &boundary.psi,
+        weights: &b.weights,
+    };
+    chebyshev.reset();
+    let accelerate = params.solver == SolverKind::Chebyshev;
+    let single_sweep = solver.single_diagonal_sweep();
+    let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
+    b.displacements.clear();
+    while outer < params.max_outer_iterations {
+        let t = Instant::now();
+        constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
+        let t_local = t.elapsed().as_secs_f64();
+        let (projections, corrections) = (&b.projections, &b.corrections);
+        let (current, predicted) = (&b.current, b.fluid_lists.searched_points());
+        // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
+        // for the particles of chunk `chunk`.
+        let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {
+            let first = chunk * CHUNK;
+            constraint.gathered_corrections(first, current, &nb, projections, corrections, rhs);
+            for (j, rhs) in (first..).zip(rhs) {
+                let members = constraint.membership(lists, j);
+                *rhs = predicted.at(j) * mass + (current[j] * members + *rhs) * dt2k;
+            }
+        };
+        if single_sweep {
+            let omega = if accelerate {
+                chebyshev.next_weight(outer)
+            } else {
+                1.0
+            };
+            let sweep = Sweep {
+                diagonal: &b.system.diagonal,
+                current,
+                previous: &b.previous,
+                chebyshev: (accelerate && chebyshev.changes(omega)).then_some((&*chebyshev, omega)),
+            };
+            // The right-hand side lives only as long as its chunk's sweep.
+            displacement = b
+                .next
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .map(|(chunk, next)| {
+                    let mut rhs = [Vec3::zeros(); CHUNK];
+                    let rhs = &mut rhs[..next.len()];
+                    fill_rhs(chunk, rhs);
+                    sweep.apply(chunk * CHUNK, rhs, next)
+                })
+                .reduce(|| f64::NEG_INFINITY, reduce::nan_max);
+            inner += 1;
+        } else {
+            b.rhs.resize(b.current.len(), Vec3::zeros());
+            b.rhs
+                .par_chunks_mut(CHUNK)
+                .enumerate()
+                .for_each(|(chunk, rhs)| fill_rhs(chunk, rhs));
+            b.next.copy_from_slice(&b.current);
+            inner += solver.solve(&b.system, &b.rhs, &mut b.next);
+            if accelerate {
+                let omega = chebyshev.next_weight(outer);
+                chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
+            }
+            displacement = max_distance(&b.next, &b.current);
+        }
+        b.displacements.push(displacement);
+
+        // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
+        std::mem::swap(&mut b.previous, &mut b.current);
+        std::mem::swap(&mut b.current, &mut b.next);
+        outer += 1;
+        timings.local += t_local;
+        timings.global += t.elapsed().as_secs_f64() - t_local;
+        if outer >= params.min_outer_iterations && displacement < params.displacement_tolerance {
+            break;
+        }
+    }
+
+    let rho = if accelerate { chebyshev.rho() } else { 0.0 };
+    if accelerate {
+        chebyshev.finish_step(&b.displacements);
+    }
+    Outcome {
+        outer,
+        inner,
+        displacement,
+        rho,
+    }
+}
+
+/// max_i |a_i − b_i| (m).
+fn max_distance(a: &[Vec3], b: &[Vec3]) -> f64 {
+    reduce::max_over(a.len(), |i| (a[i] - b[i]).norm())
+}

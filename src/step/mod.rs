@@ -1,0 +1,131 @@
+//! One time step (docs/method.md §1.3), as four phases over an explicit [`StepContext`]:
+//! [`search`] predicts s = x + Δt·v + Δt²·g, sorts the particles into Z-order and finds
+//! neighbours on s; [`iterate`] alternates local projections and global solves (with
+//! Chebyshev's extrapolation) until the displacement rule stops; [`finish`] updates the
+//! velocities, evaluates densities, applies the non-pressure forces and measures the step;
+//! [`next_step_size`] chooses the next Δt by the CFL rule (§8).
+
+mod finish;
+mod iterate;
+mod search;
+
+pub(crate) use search::SearchGrid;
+
+use crate::boundary::Boundary;
+use crate::constraint::{Corrections, DensityConstraint, Projection};
+use crate::fluid::Fluid;
+use crate::forces::NonPressureForce;
+use crate::neighbors::{CellTable, NeighborLists};
+use crate::params::Params;
+use crate::solver::{Chebyshev, DiagonalSystem, GlobalSolver};
+use crate::stats::{StepStats, StepTimings};
+use crate::{Vec3, reduce};
+use std::time::Instant;
+
+/// Buffers reused by every step, so that a step allocates nothing once sizes are stable.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct StepBuffers {
+    /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m). `current` receives the prediction
+    /// s at the start of a step; `next` also serves the reordering and the non-pressure
+    /// forces as scratch.
+    previous: Vec<Vec3>,
+    current: Vec<Vec3>,
+    next: Vec<Vec3>,
+    /// Right-hand side b of the global step (kg·m), for the solvers that are not one
+    /// Jacobi sweep (the sweep's is formed a chunk at a time).
+    rhs: Vec<Vec3>,
+    /// Local-step results per constraint.
+    projections: Vec<Projection>,
+    /// Corrections P_{i,j} − X_j of multi-step projections (m).
+    pub(crate) corrections: Corrections,
+    order: Vec<u32>,
+    table: CellTable,
+    pub(crate) fluid_lists: NeighborLists,
+    boundary_lists: NeighborLists,
+    /// The projection weight w_j of every fluid particle.
+    weights: Vec<f64>,
+    system: DiagonalSystem,
+    scratch_ids: Vec<u32>,
+    /// δ_k of every outer iteration of the last step (m).
+    pub(crate) displacements: Vec<f64>,
+}
+
+/// Everything one time step reads and writes, borrowed from the world that owns it.
+pub(crate) struct StepContext<'a> {
+    pub params: &'a Params,
+    pub constraint: &'a DensityConstraint,
+    pub pool: &'a rayon::ThreadPool,
+    pub fluid: &'a mut Fluid,
+    pub boundary: &'a mut Boundary,
+    pub grid: &'a mut SearchGrid,
+    pub solver: &'a mut dyn GlobalSolver,
+    pub chebyshev: &'a mut Chebyshev,
+    pub forces: &'a mut [Box<dyn NonPressureForce>],
+    pub buffers: &'a mut StepBuffers,
+}
+
+/// Advances the fluid by one step of `dt` seconds (positive, finite, checked by the
+/// caller) and returns what the step did with the size the next step should take (s).
+pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
+    let started = Instant::now();
+    let StepContext {
+        params,
+        constraint,
+        pool,
+        fluid,
+        boundary,
+        grid,
+        solver,
+        chebyshev,
+        forces,
+        buffers,
+    } = ctx;
+    let gravity = Vec3::from(params.gravity);
+    search::predict(pool, fluid, dt, gravity, &mut buffers.current);
+    let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
+    let mut timings = StepTimings::default();
+    let stats = pool.install(|| {
+        search::reorder_and_search(grid, fluid, boundary, params.support_radius(), buffers);
+        timings.neighbors = started.elapsed().as_secs_f64();
+        let outcome = iterate::iterate(
+            iterate::Iteration {
+                params,
+                constraint,
+                boundary,
+                solver,
+                chebyshev,
+                dt,
+            },
+            buffers,
+            &mut timings,
+        );
+        finish::finish(
+            finish::Finish {
+                params,
+                constraint,
+                boundary,
+                forces,
+                dt,
+            },
+            fluid,
+            buffers,
+            outcome,
+            &mut timings,
+        )
+    });
+    let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt));
+    (stats, next_dt)
+}
+
+/// The CFL rule (docs/method.md §8): Δt = λ·0.4·2r / max|v + Δt g|, clamped to
+/// [Δt_min, Δt_max] (s).
+fn next_step_size(params: &Params, velocities: &[Vec3], gravity: Vec3, dt: f64) -> f64 {
+    let v_max = reduce::max(velocities, |v| (v + gravity * dt).norm_squared());
+    let v_max = v_max.max(1e-9).sqrt();
+    let cfl = params.cfl_factor * 0.4 * params.spacing() / v_max;
+    if cfl.is_finite() {
+        cfl.clamp(params.dt_min, params.dt_max)
+    } else {
+        params.dt_min
+    }
+}

@@ -1,0 +1,166 @@
+//! The neighbour phase of a step (docs/method.md §1.3, §6): the inertial prediction, the
+//! grid that covers it, the Z-order sort of all per-particle arrays, and the fluid and
+//! boundary neighbour searches on s.
+
+use super::StepBuffers;
+use crate::Vec3;
+use crate::boundary::{Aabb, Boundary};
+use crate::fluid::Fluid;
+use crate::kernel::CubicKernel;
+use crate::neighbors::UniformGrid;
+use crate::params::Params;
+use rayon::prelude::*;
+
+/// The inertial prediction s = x + Δt v + Δt² g (m), into `s` (the buffer of X^(0); the
+/// search keeps a copy by component, which serves where s is read later).
+pub(super) fn predict(
+    pool: &rayon::ThreadPool,
+    fluid: &Fluid,
+    dt: f64,
+    gravity: Vec3,
+    s: &mut Vec<Vec3>,
+) {
+    pool.install(|| {
+        s.resize(fluid.len(), Vec3::zeros());
+        s.par_iter_mut()
+            .zip(fluid.positions.par_iter().zip(fluid.velocities.par_iter()))
+            .for_each(|(s, (x, v))| *s = x + v * dt + gravity * (dt * dt));
+    });
+}
+
+/// The neighbour grid, kept across steps, and whether it reached its cell limit.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct SearchGrid {
+    /// The grid, once there are particles to cover.
+    pub grid: Option<UniformGrid>,
+    /// The grid reached its cell limit and no longer grows.
+    pub capped: bool,
+}
+
+impl SearchGrid {
+    /// Makes sure there is a grid and the boundary is sorted with volumes. The grid is
+    /// (re)built, with slack around `points` and the boundary, when there is none, when the
+    /// boundary changed, or when `outgrown` (some of `points` lie outside it) unless it
+    /// already hit its cell limit; then outlying particles are clamped into border cells,
+    /// which stays correct.
+    pub fn prepare(
+        &mut self,
+        pool: &rayon::ThreadPool,
+        params: &Params,
+        kernel: &CubicKernel,
+        boundary: &mut Boundary,
+        points: &[Vec3],
+        outgrown: bool,
+    ) {
+        let outgrown = self.grid.is_none() || (outgrown && !self.capped);
+        if outgrown || boundary.dirty {
+            let bounds = [points, &boundary.positions]
+                .iter()
+                .filter_map(|p| Aabb::around(p))
+                .reduce(|a, b| a.union(&b));
+            let Some(bounds) = bounds else { return };
+            let finite = |v: Vec3| {
+                v.map(|c| {
+                    if c.is_finite() {
+                        c.clamp(-1e6, 1e6)
+                    } else {
+                        0.0
+                    }
+                })
+            };
+            // A quarter of the extent as slack, so a splash does not rebuild the grid every step.
+            let slack = (bounds.max - bounds.min) * 0.25;
+            let h = params.support_radius();
+            let grid =
+                UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h);
+            self.capped = !pool.install(|| grid.covers(points));
+            self.grid = Some(grid);
+            boundary.dirty = true;
+        }
+        if boundary.dirty {
+            self.sort_boundary(pool, params, kernel, boundary);
+        }
+    }
+
+    /// Sorts `boundary` into the grid's cells with fresh Akinci masses (nothing without a
+    /// grid).
+    pub fn sort_boundary(
+        &self,
+        pool: &rayon::ThreadPool,
+        params: &Params,
+        kernel: &CubicKernel,
+        boundary: &mut Boundary,
+    ) {
+        if let Some(grid) = &self.grid {
+            pool.install(|| boundary.sort(grid, kernel, params.rest_density));
+        }
+    }
+
+    /// Prepares the grid around the prediction in `buffers.current` and sorts it into
+    /// `buffers.order` and `buffers.table`; the sort's pass also tells whether the grid still
+    /// covers s, and if not the grid is rebuilt around it and s sorted again.
+    pub(super) fn sorted(
+        &mut self,
+        pool: &rayon::ThreadPool,
+        params: &Params,
+        kernel: &CubicKernel,
+        boundary: &mut Boundary,
+        b: &mut StepBuffers,
+    ) -> &UniformGrid {
+        self.prepare(pool, params, kernel, boundary, &b.current, false);
+        let sort = |grid: &Option<UniformGrid>, b: &mut StepBuffers| {
+            let grid = grid.as_ref().expect("prepare builds the grid");
+            pool.install(|| grid.sort(&b.current, &mut b.order, &mut b.table))
+        };
+        if !sort(&self.grid, b) && !self.capped {
+            self.prepare(pool, params, kernel, boundary, &b.current, true);
+            sort(&self.grid, b);
+        }
+        self.grid.as_ref().expect("prepare builds the grid")
+    }
+}
+
+/// Reorders all per-particle arrays by the sort's order, then finds the fluid and the
+/// boundary neighbours of every particle on s within the support radius `h` (m).
+pub(super) fn reorder_and_search(
+    grid: &UniformGrid,
+    fluid: &mut Fluid,
+    boundary: &Boundary,
+    h: f64,
+    b: &mut StepBuffers,
+) {
+    permute(&b.order, &mut fluid.positions, &mut b.next);
+    permute(&b.order, &mut fluid.velocities, &mut b.next);
+    permute(&b.order, &mut b.current, &mut b.next);
+    permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
+    grid.search(
+        &b.table,
+        &b.current,
+        &b.current,
+        h,
+        true,
+        &mut b.fluid_lists,
+    );
+    grid.search_in(
+        &boundary.table,
+        &boundary.by_component,
+        &b.current,
+        h,
+        false,
+        &mut b.boundary_lists,
+    );
+}
+
+/// Reorders `data` so that slot k holds the old `data[order[k]]`.
+fn permute<T: Copy + Send + Sync + Default>(
+    order: &[u32],
+    data: &mut Vec<T>,
+    scratch: &mut Vec<T>,
+) {
+    scratch.resize(data.len(), T::default());
+    scratch
+        .par_iter_mut()
+        .zip(order.par_iter())
+        .for_each(|(s, &o)| *s = data[o as usize]);
+    std::mem::swap(data, scratch);
+}

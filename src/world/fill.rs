@@ -1,0 +1,196 @@
+//! Adding to a world: fluid particles and blocks, boundary particles, container boxes and
+//! triangle-mesh obstacles. Every method checks its input first and changes nothing when it
+//! rejects it.
+
+use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
+use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
+use crate::boundary::{Aabb, sample_box_walls};
+use crate::{Error, Vec3};
+
+/// Most boundary particles one triangle mesh may need (by [`sample_count_bound`]), which also
+/// bounds the sampler's time and memory.
+const MAX_MESH_SAMPLES: f64 = 50e6;
+
+impl World {
+    /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
+    /// Rejects non-finite values and length mismatches without changing the world.
+    pub fn add_fluid_particles(
+        &mut self,
+        positions: &[Vec3],
+        velocities: Option<&[Vec3]>,
+    ) -> Result<(), Error> {
+        check_finite("positions", positions)?;
+        if let Some(v) = velocities {
+            if v.len() != positions.len() {
+                return Err(Error::invalid(
+                    "velocities",
+                    v.len(),
+                    &format!("must have one entry per position ({})", positions.len()),
+                ));
+            }
+            check_finite("velocities", v)?;
+        }
+        let first = self.fluid.positions.len();
+        if first + positions.len() > u32::MAX as usize / 64 {
+            return Err(Error::invalid(
+                "positions",
+                positions.len(),
+                "would exceed the particle limit",
+            ));
+        }
+        self.fluid.positions.extend_from_slice(positions);
+        match velocities {
+            Some(v) => self.fluid.velocities.extend_from_slice(v),
+            None => self
+                .fluid
+                .velocities
+                .resize(first + positions.len(), Vec3::zeros()),
+        }
+        self.fluid.densities.resize(first + positions.len(), 0.0);
+        self.fluid
+            .ids
+            .extend((first..first + positions.len()).map(|i| i as u32));
+        Ok(())
+    }
+
+    /// Adds a cubic lattice of fluid particles with spacing 2r: centres at
+    /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with `velocity`.
+    pub fn add_fluid_block(
+        &mut self,
+        start: Vec3,
+        count: [usize; 3],
+        velocity: Vec3,
+    ) -> Result<(), Error> {
+        let total = count.iter().try_fold(1usize, |acc, &c| acc.checked_mul(c));
+        match total {
+            Some(n) if n > 0 && n <= u32::MAX as usize / 64 => {}
+            _ => {
+                return Err(Error::invalid(
+                    "count",
+                    format!("{count:?}"),
+                    "must be positive and not absurdly large",
+                ));
+            }
+        }
+        let d = self.params.spacing();
+        let positions: Vec<Vec3> = (0..count[2])
+            .flat_map(|k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
+            .map(|(i, j, k)| start + Vec3::new(i as f64, j as f64, k as f64) * d)
+            .collect();
+        check_finite("start", &[start, velocity])?;
+        self.add_fluid_particles(&positions, Some(&vec![velocity; positions.len()]))
+    }
+
+    /// Adds static boundary particles at `positions` (m).
+    pub fn add_boundary_particles(&mut self, positions: &[Vec3]) -> Result<(), Error> {
+        check_finite("positions", positions)?;
+        if self.boundary.positions.len() + positions.len() > MAX_PARTICLES {
+            return Err(Error::invalid(
+                "positions",
+                positions.len(),
+                "would exceed the boundary particle limit",
+            ));
+        }
+        self.boundary.positions.extend_from_slice(positions);
+        self.boundary.dirty = true;
+        Ok(())
+    }
+
+    /// Adds a closed container box: its six walls sampled with boundary particles of spacing r,
+    /// `layers` layers thick (1–3). Fluid outside every container counts as escaped.
+    pub fn add_container(&mut self, container: Aabb, layers: usize) -> Result<(), Error> {
+        check_finite("container", &[container.min, container.max])?;
+        let r = self.params.particle_radius;
+        let size = container.max - container.min;
+        if (0..3).any(|a| size[a] < 2.0 * self.params.spacing()) {
+            return Err(Error::invalid(
+                "container",
+                format!(
+                    "{:?}..{:?}",
+                    container.min.as_slice(),
+                    container.max.as_slice()
+                ),
+                "must be at least two particle spacings wide along every axis",
+            ));
+        }
+        if !(1..=3).contains(&layers) {
+            return Err(Error::invalid("layers", layers, "must be 1, 2 or 3"));
+        }
+        if size.iter().any(|&s| s / r > 1e5) {
+            return Err(Error::invalid(
+                "container",
+                format!("{:?}", size.as_slice()),
+                "is too large for the particle radius",
+            ));
+        }
+        let expected = box_wall_sample_count(&container, r, layers);
+        if expected + self.boundary.positions.len() as f64 > MAX_PARTICLES as f64 {
+            return Err(Error::invalid(
+                "container",
+                format!("{:?}", size.as_slice()),
+                &format!("needs about {expected:.3e} boundary particles, more than the limit"),
+            ));
+        }
+        let samples = sample_box_walls(&container, r, layers);
+        self.add_boundary_particles(&samples)?;
+        self.containers.push(container);
+        Ok(())
+    }
+
+    /// Reserves room for `additional` more fluid particles in every per-particle array, so that
+    /// a following add does not fail to allocate. Changes nothing observable.
+    /// Errors when the memory cannot be had; the world stays usable.
+    pub fn try_reserve_fluid(
+        &mut self,
+        additional: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        let f = &mut self.fluid;
+        f.positions.try_reserve(additional)?;
+        f.velocities.try_reserve(additional)?;
+        f.densities.try_reserve(additional)?;
+        f.ids.try_reserve(additional)
+    }
+
+    /// Reserves room for `additional` more boundary particles (see [`World::try_reserve_fluid`]).
+    pub fn try_reserve_boundary(
+        &mut self,
+        additional: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        self.boundary.positions.try_reserve(additional)
+    }
+
+    /// Adds a static obstacle: the surface of `mesh` (m) sampled by Poisson disk with a
+    /// minimum distance of one particle radius r (see [`sample_poisson_disk`]), the samples
+    /// added as boundary particles. Their Akinci volumes are computed before the next step.
+    /// Winding does not matter and the mesh need not be closed; only the surface is sampled,
+    /// one layer thick. Errors, leaving the world unchanged, when the mesh is far larger than r
+    /// (an extent above 10⁶·r or more than about 5·10⁷ samples) or the boundary particle
+    /// limit would be exceeded.
+    pub fn add_boundary_mesh(&mut self, mesh: &TriangleMesh) -> Result<(), Error> {
+        let r = self.params.particle_radius;
+        let bounds = mesh.bounds();
+        let size = bounds.max - bounds.min;
+        if size.iter().any(|&s| s / r > 1e6) {
+            return Err(Error::invalid(
+                "mesh",
+                format!("extent {:?} m", size.as_slice()),
+                &format!("is too large for the particle radius {r} m (at most 1e6·r per axis)"),
+            ));
+        }
+        let bound = sample_count_bound(mesh, r);
+        if !(bound <= MAX_MESH_SAMPLES
+            && bound + self.boundary.positions.len() as f64 <= MAX_PARTICLES as f64)
+        {
+            return Err(Error::invalid(
+                "mesh",
+                format!("area {:.3e} m² needing up to {bound:.3e}", mesh.area()),
+                &format!(
+                    "is too large for the particle radius {r} m (at most {MAX_MESH_SAMPLES:.0e} \
+                     boundary particles, {MAX_PARTICLES} in all)"
+                ),
+            ));
+        }
+        let samples = sample_poisson_disk(mesh, r);
+        self.add_boundary_particles(&samples)
+    }
+}

@@ -1,0 +1,171 @@
+//! Reading a world: particles in the order they were added, counts, energies, escapes and
+//! a digest of the positions, and copies into caller buffers for embedders.
+
+use super::{World, check_finite};
+use crate::{Error, Vec3, reduce};
+
+impl World {
+    /// Copies a per-particle quantity into `out` in the order the particles were added.
+    fn gather_by_id<T: Copy>(&self, values: &[T], out: &mut [T]) {
+        for (v, &id) in values.iter().zip(&self.fluid.ids) {
+            out[id as usize] = *v;
+        }
+    }
+
+    /// Fluid positions (m) in the order they were added.
+    pub fn positions(&self) -> Vec<Vec3> {
+        let mut out = vec![Vec3::zeros(); self.fluid_count()];
+        self.gather_by_id(&self.fluid.positions, &mut out);
+        out
+    }
+
+    /// Fluid velocities (m/s) in the order the particles were added.
+    pub fn velocities(&self) -> Vec<Vec3> {
+        let mut out = vec![Vec3::zeros(); self.fluid_count()];
+        self.gather_by_id(&self.fluid.velocities, &mut out);
+        out
+    }
+
+    /// Replaces every fluid velocity (m/s), given in the order the particles were added.
+    /// Rejects a length mismatch or a non-finite value without changing the world.
+    pub fn set_velocities(&mut self, velocities: &[Vec3]) -> Result<(), Error> {
+        if velocities.len() != self.fluid_count() {
+            return Err(Error::invalid(
+                "velocities",
+                velocities.len(),
+                &format!(
+                    "must have one entry per fluid particle ({})",
+                    self.fluid_count()
+                ),
+            ));
+        }
+        check_finite("velocities", velocities)?;
+        let fluid = &mut self.fluid;
+        for (v, &id) in fluid.velocities.iter_mut().zip(&fluid.ids) {
+            *v = velocities[id as usize];
+        }
+        Ok(())
+    }
+
+    /// Fluid densities (kg/m³) after the last step, in the order the particles were added
+    /// (zero before the first step).
+    pub fn densities(&self) -> Vec<f64> {
+        let mut out = vec![0.0; self.fluid_count()];
+        self.gather_by_id(&self.fluid.densities, &mut out);
+        out
+    }
+
+    /// Static boundary particle positions (m), in the world's storage order.
+    pub fn boundary_positions(&self) -> &[Vec3] {
+        &self.boundary.positions
+    }
+
+    /// Kinetic energy Σ ½m|v|² (J).
+    pub fn kinetic_energy(&self) -> f64 {
+        let m = self.constraint.mass;
+        self.pool
+            .install(|| reduce::sum(&self.fluid.velocities, |v| 0.5 * m * v.norm_squared()))
+    }
+
+    /// Potential energy −Σ m g·x (J), zero at the origin.
+    pub fn potential_energy(&self) -> f64 {
+        let m = self.constraint.mass;
+        let g = Vec3::from(self.params.gravity);
+        self.pool
+            .install(|| reduce::sum(&self.fluid.positions, |x| -m * g.dot(x)))
+    }
+
+    /// Root-mean-square speed of the fluid (m/s).
+    pub fn rms_velocity(&self) -> f64 {
+        let n = self.fluid_count().max(1) as f64;
+        (self
+            .pool
+            .install(|| reduce::sum(&self.fluid.velocities, |v| v.norm_squared()))
+            / n)
+            .sqrt()
+    }
+
+    /// Fluid particles farther than r/2 outside every container, or non-finite (0 without containers).
+    pub fn escaped_count(&self) -> usize {
+        if self.containers.is_empty() {
+            return 0;
+        }
+        let margin = 0.5 * self.params.particle_radius;
+        self.fluid
+            .positions
+            .iter()
+            .filter(|p| !self.containers.iter().any(|c| c.contains(p, margin)))
+            .count()
+    }
+
+    /// Number of fluid particles with a non-finite position or velocity.
+    pub fn nan_count(&self) -> usize {
+        let bad = |v: &Vec3| !v.iter().all(|c| c.is_finite());
+        self.fluid
+            .positions
+            .iter()
+            .zip(&self.fluid.velocities)
+            .filter(|(x, v)| bad(x) || bad(v))
+            .count()
+    }
+
+    /// A hex SHA-256 digest of the positions' bit patterns in the order the particles were
+    /// added; equal digests mean bitwise identical positions.
+    pub fn positions_hash(&self) -> String {
+        use sha2::{Digest, Sha256};
+        let mut hasher = Sha256::new();
+        // The particles' slots in the order they were added (a quarter of a copy of the
+        // positions).
+        let mut slots = vec![0u32; self.fluid_count()];
+        for (slot, &id) in self.fluid.ids.iter().enumerate() {
+            slots[id as usize] = slot as u32;
+        }
+        for &slot in &slots {
+            for c in self.fluid.positions[slot as usize].iter() {
+                hasher.update(c.to_bits().to_le_bytes());
+            }
+        }
+        hasher
+            .finalize()
+            .iter()
+            .map(|b| format!("{b:02x}"))
+            .collect()
+    }
+}
+
+/// Copies into caller buffers, without allocating, for embedders such as the C API.
+impl World {
+    /// Writes fluid positions (m) as x, y, z triples of `f32` into `out[..3·fluid_count()]`, in
+    /// the order the particles were added, without allocating. Returns the number of floats
+    /// needed as the error, leaving `out` untouched, when `out` is too short.
+    pub fn write_positions_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        self.write_vectors_f32(&self.fluid.positions, out)
+    }
+
+    /// Writes fluid velocities (m/s) like [`World::write_positions_f32`].
+    pub fn write_velocities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        self.write_vectors_f32(&self.fluid.velocities, out)
+    }
+
+    /// Writes fluid densities (kg/m³, zero before the first step) into
+    /// `out[..fluid_count()]` in the order the particles were added; errs with the number of
+    /// floats needed, leaving `out` untouched, when `out` is too short.
+    pub fn write_densities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
+        let n = self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        for (&rho, &id) in self.fluid.densities.iter().zip(&self.fluid.ids) {
+            out[id as usize] = rho as f32;
+        }
+        Ok(())
+    }
+
+    fn write_vectors_f32(&self, values: &[Vec3], out: &mut [f32]) -> Result<(), usize> {
+        let n = 3 * self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        for (v, &id) in values.iter().zip(&self.fluid.ids) {
+            let i = 3 * id as usize;
+            out[i..i + 3].copy_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,163 @@
+//! The exact state of a world, exported and imported as plain data, so that a saved run
+//! (a checkpoint) continues bit for bit as if it had never stopped.
+//!
+//! Besides positions, velocities and time, a step depends on the storage order of the
+//! particles (the counting sort is stable, and the order decides the order of floating-point
+//! sums), on the neighbour grid (its origin decides the cells, hence the sort), on the
+//! boundary particles in their sorted order and on the online ρ_c estimate. All of these are
+//! part of the state, as they are.
+
+use super::World;
+use crate::boundary::Aabb;
+use crate::neighbors::UniformGrid;
+use crate::solver::OnlineRho;
+use crate::step::SearchGrid;
+use crate::{Error, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// A world's complete state apart from its parameters. Per-particle arrays are in the
+/// world's storage order; `ids` maps each stored particle to the order it was added in.
+#[derive(Clone, Debug, PartialEq)]
+pub struct WorldState {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Steps taken.
+    pub steps: u64,
+    /// The size of the next CFL-limited step (s).
+    pub next_dt: f64,
+    /// Fluid positions (m).
+    pub positions: Vec<Vec3>,
+    /// Fluid velocities (m/s).
+    pub velocities: Vec<Vec3>,
+    /// Fluid densities after the last step (kg/m³).
+    pub densities: Vec<f64>,
+    /// The index each stored fluid particle was added with: a permutation of 0..n.
+    pub ids: Vec<u32>,
+    /// Boundary particle positions (m).
+    pub boundary_positions: Vec<Vec3>,
+    /// The boundary is sorted into `grid`'s cells (else it is sorted before the next step).
+    pub boundary_sorted: bool,
+    /// Container boxes (m).
+    pub containers: Vec<Aabb>,
+    /// The neighbour grid, once a step built one.
+    pub grid: Option<GridParts>,
+    /// The grid reached its cell limit and no longer grows.
+    pub grid_capped: bool,
+    /// Chebyshev's online ρ_c estimate.
+    pub online_rho: OnlineRho,
+}
+
+/// A neighbour grid's defining numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GridParts {
+    /// The corner of cell (0, 0, 0) (m).
+    pub origin: [f64; 3],
+    /// Cell edge length (m), the kernel support.
+    pub cell_size: f64,
+    /// Cells along x, y and z.
+    pub dims: [usize; 3],
+}
+
+impl World {
+    /// The world's exact state (a copy).
+    pub fn export_state(&self) -> WorldState {
+        let fluid = &self.fluid;
+        WorldState {
+            time: self.time,
+            steps: self.steps,
+            next_dt: self.next_dt,
+            positions: fluid.positions.clone(),
+            velocities: fluid.velocities.clone(),
+            densities: fluid.densities.clone(),
+            ids: fluid.ids.clone(),
+            boundary_positions: self.boundary.positions.clone(),
+            boundary_sorted: !self.boundary.dirty,
+            containers: self.containers.clone(),
+            grid: self.grid.grid.as_ref().map(|g| {
+                let (origin, cell_size, dims) = g.parts();
+                GridParts {
+                    origin: origin.into(),
+                    cell_size,
+                    dims,
+                }
+            }),
+            grid_capped: self.grid.capped,
+            online_rho: self.chebyshev.online(),
+        }
+    }
+
+    /// Replaces the world's particles, containers, grid and time with `state`, as
+    /// [`World::export_state`] returned it; the world's parameters stay. Rejects a state
+    /// whose arrays differ in length, whose values are not finite, whose ids are not a
+    /// permutation or whose grid is invalid, changing nothing.
+    pub fn import_state(&mut self, state: WorldState) -> Result<(), Error> {
+        let n = state.positions.len();
+        for (name, len) in [
+            ("velocities", state.velocities.len()),
+            ("densities", state.densities.len()),
+            ("ids", state.ids.len()),
+        ] {
+            if len != n {
+                return Err(Error::invalid(
+                    format!("state.{name}"),
+                    len,
+                    &format!("must have one entry per position ({n})"),
+                ));
+            }
+        }
+        super::check_finite("state.positions", &state.positions)?;
+        super::check_finite("state.velocities", &state.velocities)?;
+        super::check_finite("state.boundary_positions", &state.boundary_positions)?;
+        let mut seen = vec![false; n];
+        for &id in &state.ids {
+            match seen.get_mut(id as usize) {
+                Some(s) if !*s => *s = true,
+                _ => {
+                    return Err(Error::invalid(
+                        "state.ids",
+                        id,
+                        "must be a permutation of 0..n",
+                    ));
+                }
+            }
+        }
+        if n > super::MAX_PARTICLES || state.boundary_positions.len() > super::MAX_PARTICLES {
+            return Err(Error::invalid("state", n, "exceeds the particle limit"));
+        }
+        let grid = match state.grid {
+            None => None,
+            Some(g) => Some(
+                UniformGrid::from_parts_checked(Vec3::from(g.origin), g.cell_size, g.dims)
+                    .ok_or_else(|| {
+                        Error::invalid("state.grid", format!("{g:?}"), "is not a valid grid")
+                    })?,
+            ),
+        };
+        let fluid = &mut self.fluid;
+        fluid.positions = state.positions;
+        fluid.velocities = state.velocities;
+        fluid.densities = state.densities;
+        fluid.ids = state.ids;
+        self.boundary.positions = state.boundary_positions;
+        self.containers = state.containers;
+        self.time = state.time;
+        self.steps = state.steps;
+        self.next_dt = state.next_dt;
+        self.chebyshev.set_online(state.online_rho);
+        self.grid = SearchGrid {
+            grid,
+            capped: state.grid_capped,
+        };
+        // A sorted boundary was saved in its sorted order: sorting again keeps that order and
+        // recomputes the same volumes.
+        self.boundary.dirty = !state.boundary_sorted || self.grid.grid.is_none();
+        if !self.boundary.dirty {
+            let kernel = &self.constraint.kernel;
+            self.grid
+                .sort_boundary(&self.pool, &self.params, kernel, &mut self.boundary);
+        }
+        self.last = None;
+        Ok(())
+    }
+}

@@ -1,0 +1,263 @@
+use super::*;
+use crate::boundary::Aabb;
+
+/// Velocities set in insertion order come back in insertion order after the particles
+/// were re-sorted by a step; bad input changes nothing.
+#[test]
+fn set_velocities_uses_insertion_order_and_rejects_bad_input() {
+    let mut world = World::new(Params::default()).unwrap();
+    let container = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.5),
+    };
+    world.add_container(container, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(0.1), [3, 2, 2], Vec3::zeros())
+        .unwrap();
+    world.step().unwrap();
+    let wanted: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f64, 0.5, -1.0)).collect();
+    world.set_velocities(&wanted).unwrap();
+    assert_eq!(world.velocities(), wanted);
+    assert!(world.set_velocities(&wanted[..11]).is_err());
+    let mut bad = wanted.clone();
+    bad[3].y = f64::NAN;
+    assert!(world.set_velocities(&bad).is_err());
+    assert_eq!(world.velocities(), wanted);
+}
+
+/// The time step, driven through the world.
+mod step {
+    use crate::boundary::Aabb;
+    use crate::solver::{GlobalSolver, Jacobi, SystemMatrix};
+    use crate::{Params, Vec3, World};
+
+    fn small_dam_break() -> World {
+        small_dam_break_with(Params::default())
+    }
+
+    fn small_dam_break_with(params: Params) -> World {
+        let mut world = World::new(params).unwrap();
+        let container = Aabb {
+            min: Vec3::repeat(-0.00625),
+            max: Vec3::new(1.00625, 0.80625, 0.40625),
+        };
+        world.add_container(container, 1).unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(0.05), [8, 12, 6], Vec3::zeros())
+            .unwrap();
+        world
+    }
+
+    /// The single-step shortcut (λ only, gradients recomputed in the gather) must give the
+    /// same trajectory as writing every projection's corrections out.
+    #[test]
+    fn single_step_shortcut_matches_written_corrections() {
+        let mut shortcut = small_dam_break();
+        let mut reference = small_dam_break();
+        reference.constraint.materialize_all = true;
+        let mut active = 0;
+        // 25 steps: later, round-off differences grow exponentially in the splashing flow.
+        for _ in 0..25 {
+            let a = shortcut.step().unwrap().outer_iterations;
+            let b = reference.step().unwrap().outer_iterations;
+            assert_eq!(a, b);
+            active += a;
+        }
+        assert!(
+            active > 60,
+            "the scene must exercise the constraint ({active} iterations)"
+        );
+        for (a, b) in shortcut.positions().iter().zip(reference.positions()) {
+            assert!((a - b).norm() <= 1e-12, "{a:?} vs {b:?}");
+        }
+        assert!(shortcut.last_step().unwrap().density_error_max > 0.0);
+    }
+
+    /// Steps the small dam break twice for 25 steps, once as is and once changed by
+    /// `variant`, and asserts the two trajectories are bitwise the same.
+    fn steps_bitwise_alike(variant: impl FnOnce(&mut World)) {
+        let mut plain = small_dam_break();
+        let mut changed = small_dam_break();
+        variant(&mut changed);
+        for _ in 0..25 {
+            let a = plain.step().unwrap().outer_iterations;
+            let b = changed.step().unwrap().outer_iterations;
+            assert_eq!(a, b);
+        }
+        assert!(plain.last_step().unwrap().density_error_max > 0.0);
+        assert!(plain.positions() == changed.positions());
+        assert!(plain.velocities() == changed.velocities());
+    }
+
+    /// The AVX2 builds of the projection, the gather, the densities and the XSPH filter do
+    /// the same IEEE operations in the same order as the portable ones, so the two give
+    /// bitwise the same trajectory. (On a processor without AVX2 both worlds take the
+    /// portable path.)
+    #[test]
+    fn avx2_builds_match_the_portable_ones() {
+        steps_bitwise_alike(|w| w.constraint.portable = true);
+    }
+
+    /// Predicted positions that leave the grid make the step rebuild it around them before
+    /// the search (read from the sort's pass), so every step's grid covers its prediction.
+    #[test]
+    fn grid_follows_particles_that_leave_it() {
+        let mut world = World::new(Params::default()).unwrap();
+        let velocity = Vec3::new(30.0, 0.0, 0.0);
+        world
+            .add_fluid_block(Vec3::zeros(), [2, 2, 2], velocity)
+            .unwrap();
+        let mut first = None;
+        for _ in 0..40 {
+            world.step().unwrap();
+            let grid = world.grid.grid.as_ref().unwrap();
+            let s = world.buffers.fluid_lists.searched_points();
+            let s: Vec<Vec3> = (0..s.len()).map(|i| s.at(i)).collect();
+            assert!(grid.covers(&s));
+            first.get_or_insert(grid.parts());
+        }
+        let x = world.positions()[0].x;
+        assert!(
+            x > 0.3,
+            "the block must outrun its first grid (at x = {x} m)"
+        );
+        assert_ne!(world.grid.grid.as_ref().map(|g| g.parts()), first);
+    }
+
+    /// A single Jacobi sweep that does not say so ([`GlobalSolver::single_diagonal_sweep`]
+    /// false), so that the step computes the right-hand side, the solve, the extrapolation
+    /// and the displacement in separate passes.
+    struct SeparateSweep(Jacobi);
+
+    impl GlobalSolver for SeparateSweep {
+        fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
+            self.0.solve(matrix, b, x)
+        }
+    }
+
+    /// The fused pass of a single-sweep solver (Chebyshev here) must give the trajectory of
+    /// the separate passes, bit for bit.
+    #[test]
+    fn fused_sweep_matches_separate_passes() {
+        steps_bitwise_alike(|w| w.solver = Box::new(SeparateSweep(Jacobi::single_sweep())));
+    }
+
+    /// Skipping the density evaluation after a first projection step that the Taylor bound
+    /// shows relaxing ends the projection exactly where the evaluation would: the
+    /// trajectories are bitwise the same.
+    #[test]
+    fn first_step_bound_changes_no_bit() {
+        steps_bitwise_alike(|w| w.constraint.evaluate_first_step = true);
+    }
+
+    /// With unit weights the active projections take several steps and keep their
+    /// corrections, the inactive ones do not: the compact segments of the ones kept must be
+    /// found by the gather exactly as when every projection keeps its corrections.
+    #[test]
+    fn kept_corrections_of_some_projections_match_keeping_them_all() {
+        let params = Params {
+            projection_weight: crate::ProjectionWeight::Unit,
+            ..Params::default()
+        };
+        let mut compact = small_dam_break_with(params.clone());
+        let mut reference = small_dam_break_with(params);
+        reference.constraint.materialize_all = true;
+        let (n, mut mixed) = (compact.fluid_count(), 0);
+        for _ in 0..25 {
+            let a = compact.step().unwrap().outer_iterations;
+            let b = reference.step().unwrap().outer_iterations;
+            assert_eq!(a, b);
+            let kept = compact.buffers.corrections.kept();
+            mixed += usize::from(kept > 0 && kept < n);
+        }
+        assert!(
+            mixed > 0,
+            "no step had some, but not all, projections keep corrections"
+        );
+        for (a, b) in compact.positions().iter().zip(reference.positions()) {
+            assert!((a - b).norm() <= 1e-12, "{a:?} vs {b:?}");
+        }
+    }
+
+    /// Relaxation steps exactly as [`World::advance`] does and then scales every velocity by
+    /// exp(−damping·Δt): a plain world stepped over the same step sizes, its velocities
+    /// scaled by hand after each step, ends bitwise the same; damping 0 is bitwise
+    /// [`World::advance`].
+    #[test]
+    fn relax_scales_the_velocities_of_each_step() {
+        let (seconds, damping) = (0.02, 4.0);
+        let mut relaxed = small_dam_break();
+        let steps = relaxed.relax(seconds, damping).unwrap();
+        let mut by_hand = small_dam_break();
+        let mut count = 0;
+        while seconds - by_hand.time() > 1e-12 {
+            let dt = by_hand.next_dt().min(seconds - by_hand.time());
+            by_hand.step_with_dt(dt).unwrap();
+            let factor = (-damping * dt).exp();
+            let damped: Vec<Vec3> = by_hand.velocities().iter().map(|v| v * factor).collect();
+            by_hand.set_velocities(&damped).unwrap();
+            count += 1;
+        }
+        assert!(steps > 3 && steps == count);
+        assert!(relaxed.positions() == by_hand.positions());
+        assert!(relaxed.velocities() == by_hand.velocities());
+        let mut advanced = small_dam_break();
+        let mut undamped = small_dam_break();
+        assert_eq!(
+            advanced.advance(seconds).unwrap(),
+            undamped.relax(seconds, 0.0).unwrap()
+        );
+        assert!(advanced.positions() == undamped.positions());
+        assert!(advanced.velocities() == undamped.velocities());
+        assert!(advanced.velocities() != relaxed.velocities());
+    }
+
+    /// A negative, infinite or NaN duration or damping rate is rejected, naming the argument,
+    /// and no step is taken.
+    #[test]
+    fn relax_rejects_bad_arguments_unchanged() {
+        let mut world = small_dam_break();
+        for (seconds, damping, field) in [
+            (-1.0, 1.0, "seconds"),
+            (f64::NAN, 1.0, "seconds"),
+            (0.1, -1.0, "damping"),
+            (0.1, f64::INFINITY, "damping"),
+            (0.1, f64::NAN, "damping"),
+        ] {
+            let message = world.relax(seconds, damping).unwrap_err().to_string();
+            assert!(message.contains(field), "{message}");
+            assert_eq!(world.steps(), 0);
+        }
+    }
+
+    /// `advance_with` takes the steps `advance` takes, shows every one to its callback, and
+    /// stops at the first error the callback returns, returning it.
+    #[test]
+    fn advance_with_sees_every_step_and_stops_on_error() {
+        let mut advanced = small_dam_break();
+        let mut observed = small_dam_break();
+        let steps = advanced.advance(0.02).unwrap();
+        let mut seen = Vec::new();
+        let count = observed
+            .advance_with(0.02, |w| {
+                seen.push(w.steps());
+                Ok(())
+            })
+            .unwrap();
+        assert_eq!(count, steps);
+        assert_eq!(seen, (1..=steps as u64).collect::<Vec<_>>());
+        assert!(advanced.positions() == observed.positions());
+        let mut stopped = small_dam_break();
+        let error = stopped
+            .advance_with(0.02, |w| {
+                if w.steps() == 2 {
+                    Err(crate::Error::invalid("probe", 2, "stops the run"))
+                } else {
+                    Ok(())
+                }
+            })
+            .unwrap_err();
+        assert!(error.to_string().contains("probe"));
+        assert_eq!(stopped.steps(), 2);
+    }
+}

@@ -1,6 +1,7 @@
 # Builds and installs the projfluid C library:
 #   make install PREFIX=/opt/projfluid
-# installs lib/libprojfluid.{a,so}, include/projfluid.h and lib/pkgconfig/projfluid.pc.
+# installs lib/libprojfluid.{a,so} (stripped of debugging information), include/projfluid.h
+# and lib/pkgconfig/projfluid.pc.
 # `make install-files BUILT=dir` installs already built libraries from `dir` without building.
 
 PREFIX ?= /usr/local
@@ -11,6 +12,7 @@ CARGO_TARGET_DIR ?= target
 BUILT ?= $(CARGO_TARGET_DIR)/release
 VERSION := $(shell sed -n 's/^version = "\(.*\)"/\1/p' Cargo.toml | head -n 1)
 INSTALL ?= install
+STRIP ?= strip
 
 .PHONY: all build install install-files uninstall
 
@@ -25,6 +27,7 @@ install-files:
 	$(INSTALL) -d $(DESTDIR)$(LIBDIR)/pkgconfig $(DESTDIR)$(INCLUDEDIR)
 	$(INSTALL) -m 644 $(BUILT)/libprojfluid.a $(DESTDIR)$(LIBDIR)/libprojfluid.a
 	$(INSTALL) -m 755 $(BUILT)/libprojfluid.so $(DESTDIR)$(LIBDIR)/libprojfluid.so
+	$(STRIP) --strip-debug $(DESTDIR)$(LIBDIR)/libprojfluid.a $(DESTDIR)$(LIBDIR)/libprojfluid.so
 	$(INSTALL) -m 644 include/projfluid.h $(DESTDIR)$(INCLUDEDIR)/projfluid.h
 	sed -e 's|@PREFIX@|$(PREFIX)|g' -e 's|@LIBDIR@|$(LIBDIR)|g' \
 	    -e 's|@INCLUDEDIR@|$(INCLUDEDIR)|g' -e 's|@VERSION@|$(VERSION)|g' \

@@ -1,9 +1,10 @@
 //! Exercises the C API from C: compiles `tests/c/*.c` and `c_examples/*.c` with the system
 //! `cc` (C11, all warnings as errors) against the crate's static and shared libraries, runs
 //! them, checks their exit codes and output, compares a C simulation bit for bit with the
-//! Rust API, runs the C tests under valgrind when it is installed, runs the Python ctypes
-//! example when `python3` is installed, and checks the `make install-files` layout with
-//! pkg-config.
+//! Rust API, runs the C tests under valgrind, runs the Python ctypes example, and checks the
+//! `make install-files` layout (stripped libraries) with pkg-config and the CMake example.
+//! Outside CI a missing valgrind, python3, make, pkg-config, readelf or cmake skips its
+//! check with a note; under CI it fails the test (`support/tools.rs`).
 //!
 //! Under `cargo test` the libraries sit next to this test's executable in
 //! `target/<profile>/deps/`.
@@ -14,6 +15,9 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
+
+#[path = "support/tools.rs"]
+mod tools;
 
 /// How an executable links the library.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -272,17 +276,9 @@ fn c_examples_build_and_run() {
     assert!((0.0..5.0).contains(&avg), "mean density error {avg} %");
 }
 
-fn have(tool: &str) -> bool {
-    Command::new(tool)
-        .arg("--version")
-        .output()
-        .is_ok_and(|o| o.status.success())
-}
-
 #[test]
 fn c_tests_are_clean_under_valgrind() {
-    if !have("valgrind") {
-        eprintln!("note: valgrind is not on PATH; skipping the memcheck run of the C tests");
+    if !tools::available("valgrind") {
         return;
     }
     let suppressions = root().join("tests/c/valgrind.supp");
@@ -314,8 +310,7 @@ fn c_tests_are_clean_under_valgrind() {
 
 #[test]
 fn python_ctypes_example_runs() {
-    if !have("python3") {
-        eprintln!("note: python3 is not on PATH; skipping the ctypes example");
+    if !tools::available("python3") {
         return;
     }
     let lib = lib_dir().join("libprojfluid.so");
@@ -334,9 +329,8 @@ fn python_ctypes_example_runs() {
 }
 
 #[test]
-fn make_install_layout_works_with_pkg_config() {
-    if !have("make") {
-        eprintln!("note: make is not on PATH; skipping the install layout check");
+fn make_install_layout_works_with_pkg_config_and_cmake() {
+    if !tools::available("make") {
         return;
     }
     let prefix = out_dir().join("prefix");
@@ -366,8 +360,7 @@ fn make_install_layout_works_with_pkg_config() {
     );
     assert!(pc.contains(&format!("prefix={}", prefix.display())), "{pc}");
 
-    if !have("pkg-config") {
-        eprintln!("note: pkg-config is not on PATH; skipping the pkg-config build");
+    if !tools::available("pkg-config") {
         return;
     }
     let flags = Command::new("pkg-config")
@@ -389,5 +382,45 @@ fn make_install_layout_works_with_pkg_config() {
         .expect("cc runs");
     assert!(output.status.success(), "{}", describe(&output));
     let out = run(&exe, &[]);
+    assert!(out.contains("first particle at"), "{out}");
+
+    if tools::available("readelf") {
+        for lib in ["lib/libprojfluid.so", "lib/libprojfluid.a"] {
+            let sections = Command::new("readelf")
+                .args(["--wide", "--sections"])
+                .arg(prefix.join(lib))
+                .output()
+                .expect("readelf runs");
+            let sections = String::from_utf8_lossy(&sections.stdout);
+            assert!(
+                !sections.contains(".debug_"),
+                "the installed {lib} still carries debugging information"
+            );
+        }
+    }
+
+    if !tools::available("cmake") {
+        return;
+    }
+    // The CMake example of docs/c-api.md, configured against the installed prefix.
+    let build_dir = out_dir().join("cmake-build");
+    let _ = std::fs::remove_dir_all(&build_dir);
+    let configure = Command::new("cmake")
+        .arg("-S")
+        .arg(root().join("c_examples/cmake"))
+        .arg("-B")
+        .arg(&build_dir)
+        .arg(format!("-DCMAKE_PREFIX_PATH={}", prefix.display()))
+        .env_remove("PKG_CONFIG_PATH")
+        .output()
+        .expect("cmake runs");
+    assert!(configure.status.success(), "{}", describe(&configure));
+    let compile = Command::new("cmake")
+        .arg("--build")
+        .arg(&build_dir)
+        .output()
+        .expect("cmake runs");
+    assert!(compile.status.success(), "{}", describe(&compile));
+    let out = run(&build_dir.join("minimal"), &[]);
     assert!(out.contains("first particle at"), "{out}");
 }

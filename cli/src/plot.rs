@@ -3,7 +3,7 @@
 //! into the library, so no system fonts are needed.
 //!
 //! ```no_run
-//! use projfluid::plot::{LineChart, Series, SeriesStyle};
+//! use projfluid_lab::plot::{LineChart, Series, SeriesStyle};
 //! let chart = LineChart {
 //!     title: "Surge front".into(),
 //!     x_label: "T".into(),

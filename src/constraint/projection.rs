@@ -1,0 +1,232 @@
+//! The local step: every constraint projected by Newton-like steps on a private copy of its
+//! stencil (docs/method.md §2.5), and what each projection produced ([`Projection`]).
+
+use super::gather::Corrections;
+use super::stencil::{SCRATCH, Scratch};
+use super::{
+    CHUNK, CONSTRAINT_GOAL, DensityConstraint, MAX_PROJECTION_STEPS, Neighborhood, REGULARIZATION,
+};
+use crate::Vec3;
+use crate::neighbors::par_segments_zip_mut;
+use rayon::prelude::*;
+
+/// What the local step of one constraint produced.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Projection {
+    /// λ of a projection that ended after one step (0 for an inactive constraint), in m²…
+    /// units of C/|∇C|², i.e. m².
+    pub lambda: f64,
+    /// The correction of the constraint's own particle, P_{i,i} − x_i (m).
+    pub self_correction: Vec3,
+    /// The neighbours' corrections were written out (multi-step projection), to the segment
+    /// of [`Corrections`] that starts at `segment`.
+    pub materialized: bool,
+    /// Start of this constraint's segment in [`Corrections`] (meaningful when `materialized`).
+    pub segment: u32,
+}
+
+impl DensityConstraint {
+    /// The local step: projects every constraint i at the iterate `x`. Single-step projections
+    /// (the usual case) keep only λ_i; longer ones write their stencil corrections
+    /// P_{i,j} − x_j (m) into `corrections`: once all constraints are projected, the few
+    /// multi-step ones are projected again into segments sized for them alone (a projection
+    /// is a pure function of `x`, so the second pass repeats the first bit for bit).
+    pub fn project(
+        &self,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        projections: &mut Vec<Projection>,
+        corrections: &mut Corrections,
+    ) {
+        let c = corrections;
+        projections.resize(x.len(), Projection::default());
+        c.lambdas.resize(x.len(), 0.0);
+        c.moved.resize(x.len(), 0);
+        let any_kept = projections
+            .par_chunks_mut(CHUNK)
+            .zip(c.lambdas.par_chunks_mut(CHUNK))
+            .zip(c.moved.par_chunks_mut(CHUNK))
+            .enumerate()
+            .map(|(chunk, ((outs, lambdas), moved))| {
+                SCRATCH.with_borrow_mut(|scratch| {
+                    // Corrections written here are dropped; the buffer only grows.
+                    let mut dp = std::mem::take(&mut scratch.dp);
+                    let mut kept = false;
+                    for (k, ((out, lambda), moved)) in
+                        outs.iter_mut().zip(lambdas).zip(moved).enumerate()
+                    {
+                        let i = chunk * CHUNK + k;
+                        let members = nb.fluid.count(i) + 1;
+                        if dp.len() < members {
+                            dp.resize(members, Vec3::zeros());
+                        }
+                        self.project_one(i, x, nb, &mut dp[..members], out, scratch);
+                        *lambda = if out.materialized { 0.0 } else { out.lambda };
+                        *moved = u8::from(*lambda != 0.0);
+                        kept |= out.materialized;
+                    }
+                    scratch.dp = dp;
+                    kept
+                })
+            })
+            .reduce(|| false, |a, b| a || b);
+
+        // The flags were set only if the last local step kept a segment (rarely); only then
+        // are they cleared.
+        let flags_set = !c.owners.is_empty();
+        c.owners.clear();
+        if any_kept {
+            c.owners.par_extend(
+                (0..projections.len() as u32)
+                    .into_par_iter()
+                    .filter(|&i| projections[i as usize].materialized),
+            );
+        }
+        if c.near_kept.len() != projections.len() || flags_set {
+            c.near_kept.clear();
+            c.near_kept.resize(projections.len(), false);
+        }
+        for &i in &c.owners {
+            for &j in nb.fluid.of(i as usize) {
+                c.near_kept[j as usize] = true;
+            }
+        }
+        c.offsets.clear();
+        c.offsets.push(0);
+        for &i in &c.owners {
+            let start = *c.offsets.last().unwrap_or(&0);
+            projections[i as usize].segment = start;
+            c.offsets
+                .push(start + nb.fluid.count(i as usize) as u32 + 1);
+        }
+        c.data.clear();
+        c.data
+            .resize(*c.offsets.last().unwrap_or(&0) as usize, Vec3::zeros());
+        par_segments_zip_mut(&c.offsets, &mut c.data, &mut c.owners, |_, dp, &mut i| {
+            let mut again = Projection::default();
+            SCRATCH.with_borrow_mut(|scratch| {
+                self.project_one(i as usize, x, nb, dp, &mut again, scratch)
+            });
+        });
+    }
+
+    /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary
+    /// particles are not unknowns); `grads[s]` receives ∇_{p_j} C_i = −(m/ρ0)∇W(p_i − p_j)
+    /// for the s-th fluid neighbour at `neighbor(s)`.
+    fn gradients(
+        &self,
+        i: usize,
+        pi: Vec3,
+        neighbor: impl Fn(usize) -> Vec3,
+        nb: &Neighborhood,
+        grads: &mut Vec<Vec3>,
+    ) -> (Vec3, f64) {
+        let kernel = &self.kernel;
+        let scale = self.mass / self.rest_density;
+        let mut grad_i: Vec3 = nb
+            .boundary
+            .of(i)
+            .iter()
+            .map(|&b| {
+                let b = b as usize;
+                kernel.grad_w(&(pi - nb.boundary_positions[b])) * nb.boundary_psi[b]
+            })
+            .sum::<Vec3>()
+            / self.rest_density;
+        let mut denominator = 0.0;
+        grads.clear();
+        for s in 0..nb.fluid.count(i) {
+            let g = kernel.grad_w(&(pi - neighbor(s))) * scale;
+            grad_i += g;
+            denominator += g.norm_squared();
+            grads.push(-g);
+        }
+        (grad_i, denominator + grad_i.norm_squared())
+    }
+
+    crate::simd::avx2_dispatch! {
+        /// Projection of constraint i (docs/method.md §2.5): Newton-like steps on a private
+        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after
+        /// its first step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]`
+        /// (s-th neighbour) receive the corrections. The AVX2 build runs the loops over a
+        /// stencil's members four lanes wide, bitwise alike (tested).
+        fn project_one / project_one_avx2(
+            &self,
+            i: usize,
+            x: &[Vec3],
+            nb: &Neighborhood,
+            dp: &mut [Vec3],
+            out: &mut Projection,
+            scratch: &mut Scratch,
+        ) where !self.portable => project_one_portable
+    }
+
+    /// The body of [`Self::project_one`], inlined into both builds.
+    #[inline(always)]
+    fn project_one_portable(
+        &self,
+        i: usize,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        dp: &mut [Vec3],
+        out: &mut Projection,
+        scratch: &mut Scratch,
+    ) {
+        *out = Projection::default();
+        let members = nb.fluid.of(i);
+        let at = |s: usize| x[members[s] as usize];
+        let w = |s: usize| self.weight_of(nb, members[s] as usize);
+        let mut materialized = false;
+        let mut relaxes = false;
+        for step in 0..MAX_PROJECTION_STEPS {
+            if relaxes {
+                // ρ_i after the first step is surely ≤ ρ0: the projection ends here.
+                break;
+            }
+            let pi = x[i] + out.self_correction;
+            let rho = match (step, materialized) {
+                (0, _) => self.first_density(i, pi, x, nb, scratch),
+                (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
+                // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
+                (_, false) => self.first_step_density(out, scratch),
+            };
+            let c = (rho / self.rest_density - 1.0).max(0.0);
+            if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
+                // A second step is needed (or requested): write the first step's corrections out.
+                dp[0] = out.self_correction;
+                let m = &scratch.members;
+                for (s, w) in m.weights[..m.n].iter().enumerate() {
+                    dp[s + 1] = m.gradient(s) * (out.lambda * w);
+                }
+                materialized = true;
+            }
+            if c <= CONSTRAINT_GOAL {
+                break;
+            }
+            let (grad_i, denominator) = if materialized {
+                self.gradients(i, pi, |s| at(s) + dp[s + 1], nb, &mut scratch.grads)
+            } else {
+                // Only the first step is not materialized: the iterate's offsets are kept.
+                self.first_gradients(i, nb, scratch)
+            };
+            if denominator == 0.0 {
+                break;
+            }
+            let lambda = -c / (denominator + REGULARIZATION);
+            let w_i = self.weight_of(nb, i);
+            out.self_correction += grad_i * (lambda * w_i);
+            if step == 0 && !self.evaluate_first_step && !self.materialize_all {
+                relaxes = self.first_step_surely_relaxes(rho, lambda, grad_i, w_i, scratch);
+            }
+            if materialized {
+                for (s, g) in scratch.grads.iter().enumerate() {
+                    dp[s + 1] += g * (lambda * w(s));
+                }
+                dp[0] = out.self_correction;
+            } else {
+                out.lambda = lambda;
+            }
+        }
+        out.materialized = materialized;
+    }
+}

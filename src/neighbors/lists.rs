@@ -1,0 +1,148 @@
+//! Neighbour lists in compressed (CSR) form, kept in the blocks the search wrote them in;
+//! points by component; and the parallel walk over CSR segments.
+
+use super::BLOCK;
+use crate::Vec3;
+use rayon::prelude::*;
+
+/// Neighbour lists in compressed form, kept where the search wrote them: the queries are
+/// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`, each list
+/// ascending.
+#[derive(Clone, Debug, Default)]
+pub struct NeighborLists {
+    /// The number of queries.
+    pub(super) queries: usize,
+    /// Per block of queries: where each query's list starts in the block's concatenated
+    /// lists (one more entry than queries), and those lists.
+    pub(super) blocks: Vec<(Vec<u32>, Vec<u32>)>,
+    /// The searched points by component, for [`UniformGrid::search`].
+    ///
+    /// [`UniformGrid::search`]: super::UniformGrid::search
+    pub(super) coordinates: PointsByComponent,
+}
+
+impl NeighborLists {
+    /// The neighbours of query `i`.
+    #[inline]
+    pub fn of(&self, i: usize) -> &[u32] {
+        let (starts, found) = &self.blocks[i / BLOCK];
+        let k = i % BLOCK;
+        &found[starts[k] as usize..starts[k + 1] as usize]
+    }
+
+    /// The number of neighbours of query `i`.
+    #[inline]
+    pub fn count(&self, i: usize) -> usize {
+        let starts = &self.blocks[i / BLOCK].0;
+        let k = i % BLOCK;
+        (starts[k + 1] - starts[k]) as usize
+    }
+
+    /// Number of queries.
+    pub fn len(&self) -> usize {
+        self.queries
+    }
+
+    /// True when there are no queries.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The points searched by the last [`UniformGrid::search`] into these lists, by
+    /// component (m).
+    ///
+    /// [`UniformGrid::search`]: super::UniformGrid::search
+    pub fn searched_points(&self) -> &PointsByComponent {
+        &self.coordinates
+    }
+
+    /// The number of neighbours of all queries together (pairs found).
+    pub fn pairs(&self) -> usize {
+        self.blocks.iter().map(|(_, found)| found.len()).sum()
+    }
+}
+
+/// Runs `f(i, segment_i, &mut items[i])` in parallel over the CSR segments
+/// `data[offsets[i]..offsets[i + 1]]` together with one item per segment.
+pub fn par_segments_zip_mut<T: Send, U: Send>(
+    offsets: &[u32],
+    data: &mut [T],
+    items: &mut [U],
+    f: impl Fn(usize, &mut [T], &mut U) + Sync,
+) {
+    let n = offsets.len().saturating_sub(1);
+    assert_eq!(items.len(), n, "one item per segment");
+    let mut pieces = Vec::with_capacity(n.div_ceil(BLOCK));
+    let (mut rest, mut rest_items) = (data, items);
+    for b in 0..n.div_ceil(BLOCK) {
+        let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
+        let (head, tail) = rest.split_at_mut((offsets[hi] - offsets[lo]) as usize);
+        let (head_items, tail_items) = rest_items.split_at_mut(hi - lo);
+        pieces.push((lo, head, head_items));
+        rest = tail;
+        rest_items = tail_items;
+    }
+    pieces.into_par_iter().for_each(|(lo, chunk, chunk_items)| {
+        let base = offsets[lo] as usize;
+        for (k, item) in chunk_items.iter_mut().enumerate() {
+            let i = lo + k;
+            let (a, b) = (offsets[i] as usize - base, offsets[i + 1] as usize - base);
+            f(i, &mut chunk[a..b], item);
+        }
+    });
+}
+
+/// Points by component (m): a structure of arrays, so that the distance tests of a cell's
+/// points run several lanes wide.
+#[derive(Clone, Debug, Default)]
+pub struct PointsByComponent {
+    pub(super) x: Vec<f64>,
+    pub(super) y: Vec<f64>,
+    pub(super) z: Vec<f64>,
+}
+
+impl PointsByComponent {
+    /// Replaces the contents with the points of `ranges` of `points`, in that order.
+    pub(super) fn copy_ranges(
+        &mut self,
+        points: &PointsByComponent,
+        ranges: &[std::ops::Range<usize>],
+    ) {
+        for (out, from) in [
+            (&mut self.x, &points.x),
+            (&mut self.y, &points.y),
+            (&mut self.z, &points.z),
+        ] {
+            out.clear();
+            for range in ranges {
+                out.extend_from_slice(&from[range.clone()]);
+            }
+        }
+    }
+
+    /// Point `i` (m).
+    #[inline]
+    pub fn at(&self, i: usize) -> Vec3 {
+        Vec3::new(self.x[i], self.y[i], self.z[i])
+    }
+
+    /// The number of points.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True when there are no points.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+
+    /// Replaces the contents with `points` (m), in one parallel pass.
+    pub fn fill(&mut self, points: &[Vec3]) {
+        for out in [&mut self.x, &mut self.y, &mut self.z] {
+            out.resize(points.len(), 0.0);
+        }
+        (&mut self.x[..], &mut self.y[..], &mut self.z[..], points)
+            .into_par_iter()
+            .for_each(|(x, y, z, p)| (*x, *y, *z) = (p.x, p.y, p.z));
+    }
+}

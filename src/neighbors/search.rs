@@ -1,0 +1,350 @@
+//! The search: for every query, the points within the radius among those of its cell and
+//! the adjacent cells, in blocks of queries searched in parallel, by the portable build or
+//! the AVX2 or AVX-512 build the processor runs (docs/method.md §6).
+
+#[cfg(target_arch = "x86_64")]
+use super::avx::push_within_avx512;
+use super::{BLOCK, CellTable, NeighborLists, PointsByComponent, UniformGrid};
+use crate::Vec3;
+use rayon::prelude::*;
+
+impl UniformGrid {
+    /// For every query point, the indices of `points` (already in the order of `table`) within
+    /// `radius` (≤ cell size), sorted ascending. With `exclude_self`, query i skips point i.
+    pub fn search(
+        &self,
+        table: &CellTable,
+        points: &[Vec3],
+        queries: &[Vec3],
+        radius: f64,
+        exclude_self: bool,
+        out: &mut NeighborLists,
+    ) {
+        let mut coordinates = std::mem::take(&mut out.coordinates);
+        coordinates.fill(points);
+        self.search_in(table, &coordinates, queries, radius, exclude_self, out);
+        out.coordinates = coordinates;
+    }
+
+    /// [`UniformGrid::search`] among `points` already copied by component (for points that
+    /// do not move, such as the boundary's, copied once): they must be the points `table`
+    /// sorted, in its order.
+    ///
+    /// # Panics
+    /// If `points` and `table` differ in length, or `radius` exceeds the cell size.
+    pub fn search_in(
+        &self,
+        table: &CellTable,
+        points: &PointsByComponent,
+        queries: &[Vec3],
+        radius: f64,
+        exclude_self: bool,
+        out: &mut NeighborLists,
+    ) {
+        let first = exclude_self.then_some(0);
+        self.search_from(table, points, queries, first, radius, out);
+    }
+
+    /// [`UniformGrid::search_in`] for a run of the points themselves: with `Some(first)` the
+    /// queries are the points `first..first + queries.len()` and each skips itself (so that
+    /// a large set can be searched among itself a part at a time); with `None` no query
+    /// skips anything. List k belongs to query k.
+    pub(crate) fn search_from(
+        &self,
+        table: &CellTable,
+        points: &PointsByComponent,
+        queries: &[Vec3],
+        first_self: Option<usize>,
+        radius: f64,
+        out: &mut NeighborLists,
+    ) {
+        assert!(
+            radius <= self.cell_size,
+            "search radius exceeds the cell size"
+        );
+        assert_eq!(
+            points.x.len(),
+            table.point_count(),
+            "search: not the points the table sorted"
+        );
+        let r2 = radius * radius;
+        let blocks = queries.len().div_ceil(BLOCK);
+        out.blocks.resize_with(blocks, Default::default);
+        out.blocks
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(b, (starts, found))| {
+                let first = b * BLOCK;
+                let queries = &queries[first..(first + BLOCK).min(queries.len())];
+                let block = Block {
+                    grid: self,
+                    table,
+                    points,
+                    r2,
+                    exclude_self: first_self.map(|own| own + first),
+                };
+                block.search(queries, starts, found);
+            });
+        out.queries = queries.len();
+    }
+}
+
+/// One block of queries of [`UniformGrid::search`].
+pub(super) struct Block<'a> {
+    pub(super) grid: &'a UniformGrid,
+    pub(super) table: &'a CellTable,
+    pub(super) points: &'a PointsByComponent,
+    /// Squared search radius (m²).
+    pub(super) r2: f64,
+    /// With `Some(first)`, query k of the block is point `first + k` and skips itself.
+    pub(super) exclude_self: Option<usize>,
+}
+
+impl Block<'_> {
+    /// Replaces `found` with the neighbours of every query, one list after another, and
+    /// `starts` with where each list starts there (and, last, where the last one ends): eight
+    /// distance tests per instruction in the AVX-512 build, four in the AVX2 build, the same
+    /// lists from every build (tested).
+    fn search(&self, queries: &[Vec3], starts: &mut Vec<u32>, found: &mut Vec<u32>) {
+        #[cfg(target_arch = "x86_64")]
+        if crate::simd::has_avx512() {
+            // SAFETY: the processor supports the build's features, checked just above.
+            return unsafe { self.search_avx512(queries, starts, found) };
+        }
+        self.search_avx2_or_portable(queries, starts, found)
+    }
+
+    /// The body of [`Block::search`] with the portable distance tests, inlined into the
+    /// portable and the AVX2 build.
+    #[inline(always)]
+    pub(super) fn search_portable(
+        &self,
+        queries: &[Vec3],
+        starts: &mut Vec<u32>,
+        found: &mut Vec<u32>,
+    ) {
+        self.search_with::<false, false>(queries, starts, found)
+    }
+
+    /// The body of [`Block::search`]. With `AVX512` (only instantiated so by
+    /// [`Block::search_avx512`]) the candidates are tested where they lie, eight lanes wide,
+    /// and the neighbours found are compressed into `found` a vector at a time, skipping
+    /// candidates by groups with `SPARSE` ([`push_within_avx512`]); without, they are first
+    /// copied into one run.
+    #[inline(always)]
+    pub(super) fn search_with<const AVX512: bool, const SPARSE: bool>(
+        &self,
+        queries: &[Vec3],
+        starts: &mut Vec<u32>,
+        found: &mut Vec<u32>,
+    ) {
+        let grid = self.grid;
+        let p = self.points;
+        starts.clear();
+        starts.push(0);
+        found.clear();
+        // The points of the previous query's cell and its neighbour cells, in ascending
+        // Z-rank of the cells (so their indices ascend and no list needs sorting): the
+        // ranges of the cells, and (without `AVX512`) their points copied into one run that
+        // every query of the cell tests in long loops.
+        let mut cached: Option<[usize; 3]> = None;
+        let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
+        // The thread's buffers for that run, kept from block to block (they only grow;
+        // the AVX-512 build, which tests the ranges in place, leaves them empty).
+        let (mut candidates, mut ids) = CANDIDATES.take();
+        for (k, q) in queries.iter().enumerate() {
+            let c = grid.cell_of(q);
+            if cached != Some(c) {
+                cached = Some(c);
+                ranges.clear();
+                for z in c[2].saturating_sub(1)..=(c[2] + 1).min(grid.dims[2] - 1) {
+                    for y in c[1].saturating_sub(1)..=(c[1] + 1).min(grid.dims[1] - 1) {
+                        for x in c[0].saturating_sub(1)..=(c[0] + 1).min(grid.dims[0] - 1) {
+                            let rank = grid.rank([x, y, z]);
+                            let cells = &self.table.cell_start;
+                            let (start, end) = (cells[rank] as usize, cells[rank + 1] as usize);
+                            // Empty cells are left out (most cells of the boundary's table).
+                            if start < end {
+                                ranges.push(start..end);
+                            }
+                        }
+                    }
+                }
+                ranges.sort_unstable_by_key(|r| r.start);
+                if AVX512 {
+                    // Tested where they lie: cells adjacent in Z-order make one run.
+                    ranges.dedup_by(|next, run| {
+                        let adjacent = run.end == next.start;
+                        if adjacent {
+                            run.end = next.end;
+                        }
+                        adjacent
+                    });
+                } else {
+                    candidates.copy_ranges(p, &ranges);
+                    ids.clear();
+                    for r in &ranges {
+                        ids.extend(r.start as u32..r.end as u32);
+                    }
+                }
+            }
+            #[cfg(target_arch = "x86_64")]
+            if AVX512 {
+                let own = self.exclude_self.map(|first| first + k);
+                // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
+                // processor has AVX-512; the ranges lie within the table's points.
+                unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
+                starts.push(found.len() as u32);
+                continue;
+            }
+            let own = self
+                .exclude_self
+                .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
+            push_within_portable(q, &candidates, &ids, own, self.r2, found);
+            starts.push(found.len() as u32);
+        }
+        CANDIDATES.set((candidates, ids));
+    }
+}
+
+/// Appends to `found`, in order, the `ids` of the `candidates` within √`r2` (m) of `q`,
+/// except the candidate at index `own`.
+#[inline(always)]
+pub(super) fn push_within_portable(
+    q: &Vec3,
+    candidates: &PointsByComponent,
+    ids: &[u32],
+    own: Option<usize>,
+    r2: f64,
+    found: &mut Vec<u32>,
+) {
+    let cand = candidates;
+    for lo in (0..ids.len()).step_by(64) {
+        // The distance tests of up to 64 points into the bits of a mask (they vectorise),
+        // then one push per set bit (no branch per candidate).
+        let hi = (lo + 64).min(ids.len());
+        let mut mask = 0u64;
+        for (bit, ((x, y), z)) in cand.x[lo..hi]
+            .iter()
+            .zip(&cand.y[lo..hi])
+            .zip(&cand.z[lo..hi])
+            .enumerate()
+        {
+            let (dx, dy, dz) = (x - q.x, y - q.y, z - q.z);
+            mask |= u64::from(dx * dx + dy * dy + dz * dz <= r2) << bit;
+        }
+        if let Some(own) = own.filter(|own| (lo..hi).contains(own)) {
+            mask &= !(1 << (own - lo));
+        }
+        while mask != 0 {
+            found.push(ids[lo + mask.trailing_zeros() as usize]);
+            mask &= mask - 1;
+        }
+    }
+}
+
+thread_local! {
+    /// The candidate points of a block's current cell and their indices, per thread.
+    static CANDIDATES: std::cell::Cell<(PointsByComponent, Vec<u32>)> = Default::default();
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::neighbors::test_points::{random_points, sorted_copy};
+
+    #[test]
+    fn search_equals_brute_force() {
+        let radius = 0.1;
+        // Some points deliberately outside the grid's domain to exercise clamping.
+        let mut pts = random_points(4000, 42, 1.0);
+        pts.extend(
+            random_points(200, 9, 3.0)
+                .into_iter()
+                .map(|p| p - Vec3::repeat(1.0)),
+        );
+        // A dense clump: cells holding more than 64 points are tested in several chunks.
+        pts.extend(
+            random_points(300, 5, 0.06)
+                .into_iter()
+                .map(|p| p + Vec3::repeat(0.52)),
+        );
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &pts, &mut table);
+        let mut lists = NeighborLists::default();
+        grid.search(&table, &sorted, &sorted, radius, true, &mut lists);
+        assert_eq!(lists.len(), sorted.len());
+        let mut total = 0;
+        for (i, p) in sorted.iter().enumerate() {
+            let brute: Vec<u32> = (0..sorted.len() as u32)
+                .filter(|&j| j as usize != i && (sorted[j as usize] - p).norm() <= radius)
+                .collect();
+            assert_eq!(lists.of(i), brute.as_slice(), "query {i}");
+            total += brute.len();
+        }
+        assert!(
+            total > 10_000,
+            "test should exercise many pairs, got {total}"
+        );
+
+        // Queries against a second point set copied by component once (as the boundary's),
+        // searched twice with different queries.
+        let others = random_points(1500, 3, 1.0);
+        let sorted_others = sorted_copy(&grid, &others, &mut table);
+        let mut prepared = PointsByComponent::default();
+        prepared.fill(&sorted_others);
+        for queries in [&sorted, &random_points(700, 8, 1.0)] {
+            grid.search_in(&table, &prepared, queries, radius, false, &mut lists);
+            assert_eq!(lists.len(), queries.len());
+            for (i, p) in queries.iter().enumerate() {
+                let brute: Vec<u32> = (0..sorted_others.len() as u32)
+                    .filter(|&j| (sorted_others[j as usize] - p).norm() <= radius)
+                    .collect();
+                assert_eq!(lists.of(i), brute.as_slice());
+            }
+        }
+    }
+
+    /// A point set that is not the one the table sorted is refused with a clear message,
+    /// not searched out of bounds.
+    #[test]
+    #[should_panic(expected = "not the points the table sorted")]
+    fn search_rejects_points_of_another_table() {
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let mut table = CellTable::default();
+        let sorted = sorted_copy(&grid, &random_points(50, 1, 1.0), &mut table);
+        let mut prepared = PointsByComponent::default();
+        prepared.fill(&sorted[..40]);
+        grid.search_in(
+            &table,
+            &prepared,
+            &sorted,
+            0.1,
+            false,
+            &mut NeighborLists::default(),
+        );
+    }
+
+    #[test]
+    fn results_do_not_depend_on_thread_count() {
+        let pts = random_points(5000, 11, 1.0);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let run = |threads| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            pool.install(|| {
+                let mut table = CellTable::default();
+                let sorted = sorted_copy(&grid, &pts, &mut table);
+                let mut lists = NeighborLists::default();
+                grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
+                (0..lists.len())
+                    .map(|i| lists.of(i).to_vec())
+                    .collect::<Vec<_>>()
+            })
+        };
+        assert_eq!(run(1), run(3));
+    }
+}

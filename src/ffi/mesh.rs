@@ -1,12 +1,12 @@
 //! Obstacles in the C API: triangle meshes given as arrays or read from OBJ files, placed by
 //! a `PfTransform`, their surfaces sampled with boundary particles.
 
-use super::input_slice;
+use super::checked::Args;
 use super::status::{Failure, status_call};
-use super::world::{PfWorld, check_count, lock, read_vectors};
+use super::world::{PfWorld, check_count, read_vectors};
 use crate::boundary::Transform;
 use crate::boundary::mesh::TriangleMesh;
-use std::ffi::{CStr, c_char};
+use std::ffi::c_char;
 
 /// Where a mesh goes: every vertex p becomes `translate + R·(scale ∘ p)`, i.e. a per-axis
 /// scale about the origin, then a rotation, then a translation. The rotation is given as
@@ -42,31 +42,25 @@ impl From<PfTransform> for Transform {
 /// `out` must be NULL or point to a writable `PfTransform`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pf_transform_identity(out: *mut PfTransform) -> super::PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_transform_identity", || {
-        let out = super::checked_mut_ptr(out, "out")?;
         let t = Transform::default();
-        // SAFETY: non-NULL and aligned; writability is the caller's promise.
-        unsafe {
-            out.write(PfTransform {
-                scale: t.scale,
-                rotate_deg: t.rotate_deg,
-                translate: t.translate,
-            })
+        let identity = PfTransform {
+            scale: t.scale,
+            rotate_deg: t.rotate_deg,
+            translate: t.translate,
         };
-        Ok(())
+        args.write(out, identity, "out")
     })
 }
 
 /// The transform behind `transform`: the identity when NULL, else the caller's, validated.
-///
-/// # Safety
-/// `transform`, when non-NULL, must point to a readable `PfTransform`.
-unsafe fn read_transform(transform: *const PfTransform) -> Result<Transform, Failure> {
+fn read_transform(args: Args, transform: *const PfTransform) -> Result<Transform, Failure> {
     if transform.is_null() {
         return Ok(Transform::default());
     }
-    // SAFETY: forwarded from the caller.
-    let t: Transform = unsafe { input_slice(transform, 1, "transform") }?[0].into();
+    let t: Transform = args.slice(transform, 1, "transform")?[0].into();
     t.validate()
         .map_err(|e| Failure::invalid(format!("transform.{e}")))?;
     Ok(t)
@@ -96,9 +90,18 @@ pub unsafe extern "C" fn pf_world_add_mesh(
     indices: *const u32,
     triangle_count: usize,
 ) -> super::PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_world_add_mesh", || {
-        // SAFETY: forwarded from the caller's promises.
-        unsafe { add_mesh(world, vertices, vertex_count, indices, triangle_count, None) }
+        add_mesh(
+            args,
+            world,
+            vertices,
+            vertex_count,
+            indices,
+            triangle_count,
+            None,
+        )
     })
 }
 
@@ -122,28 +125,25 @@ pub unsafe extern "C" fn pf_world_add_mesh_transformed(
     triangle_count: usize,
     transform: *const PfTransform,
 ) -> super::PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_world_add_mesh_transformed", || {
-        // SAFETY: forwarded from the caller's promises.
-        let transform = unsafe { read_transform(transform) }?;
-        // SAFETY: as above.
-        unsafe {
-            add_mesh(
-                world,
-                vertices,
-                vertex_count,
-                indices,
-                triangle_count,
-                Some(transform),
-            )
-        }
+        let transform = read_transform(args, transform)?;
+        add_mesh(
+            args,
+            world,
+            vertices,
+            vertex_count,
+            indices,
+            triangle_count,
+            Some(transform),
+        )
     })
 }
 
 /// Reads a mesh from the caller's arrays, places it and adds it to the world.
-///
-/// # Safety
-/// As `pf_world_add_mesh`.
-unsafe fn add_mesh(
+fn add_mesh(
+    args: Args,
     world: *mut PfWorld,
     vertices: *const f32,
     vertex_count: usize,
@@ -151,14 +151,12 @@ unsafe fn add_mesh(
     triangle_count: usize,
     transform: Option<Transform>,
 ) -> Result<(), Failure> {
-    // SAFETY: forwarded from the caller's promises.
-    let mut world = unsafe { lock(world) }?;
+    let mut world = args.world(world)?;
     check_count(vertex_count).map_err(|f| named(f, "vertex_count"))?;
     check_count(triangle_count).map_err(|f| named(f, "triangle_count"))?;
-    // SAFETY: as above; vertex_count ≤ MAX_PARTICLES_PER_CALL, so 3·vertex_count fits.
-    let positions = unsafe { read_vectors(vertices, vertex_count, "vertices") }?;
-    // SAFETY: as above; triangle_count ≤ MAX_PARTICLES_PER_CALL, so 3·triangle_count fits.
-    let flat = unsafe { input_slice(indices, 3 * triangle_count, "indices") }?;
+    let positions = read_vectors(args, vertices, vertex_count, "vertices")?;
+    // triangle_count ≤ MAX_PARTICLES_PER_CALL, so 3·triangle_count fits.
+    let flat = args.slice(indices, 3 * triangle_count, "indices")?;
     let mut triangles = Vec::new();
     triangles
         .try_reserve_exact(triangle_count)
@@ -193,16 +191,15 @@ pub unsafe extern "C" fn pf_world_add_obj(
     path: *const c_char,
     transform: *const PfTransform,
 ) -> super::PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_world_add_obj", || {
-        // SAFETY: forwarded from the caller's promises.
-        let mut world = unsafe { lock(world) }?;
-        let path = super::checked_ptr(path, "path")?;
-        // SAFETY: non-NULL; NUL termination is the caller's promise.
-        let path = unsafe { CStr::from_ptr(path) }
+        let mut world = args.world(world)?;
+        let path = args
+            .c_str(path, "path")?
             .to_str()
             .map_err(|_| Failure::invalid("path must be UTF-8"))?;
-        // SAFETY: as above.
-        let transform = unsafe { read_transform(transform) }?;
+        let transform = read_transform(args, transform)?;
         let mesh = crate::io::load_obj(std::path::Path::new(path))?;
         let mesh = transform
             .apply(&mesh)

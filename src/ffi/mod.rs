@@ -7,12 +7,14 @@
 //!   are only written on success, except `*needed`, and `*out` of `pf_world_create`, which is
 //!   set to NULL), and [`pf_last_error_message`] tells what was wrong.
 //! - Every call goes through one wrapper (`status::call`) that catches panics
-//!   (`PF_ERROR_PANIC`), checks pointers (`PF_ERROR_NULL_POINTER`) and records the message.
+//!   (`PF_ERROR_PANIC`) and records the message; its pointer arguments are reached only
+//!   through `checked::Args`, which checks them (`PF_ERROR_NULL_POINTER`, misalignment).
 //! - Arrays of 3-vectors are flat `x, y, z, x, y, z, …` `float` arrays in metres (positions)
 //!   or m/s (velocities). Particles are reported in the order they were added.
 //! - Thread safety: one world must not be used from two threads at once (a call that finds
 //!   the world busy returns `PF_ERROR_BUSY`); distinct worlds may be used in parallel.
 
+mod checked;
 mod mesh;
 mod params;
 mod status;
@@ -25,65 +27,3 @@ pub use params::{pf_params_default, pf_params_validate};
 pub use status::{PfStatus, pf_last_error_message, pf_status_name};
 pub use version::{PF_ABI_VERSION, pf_abi_version, pf_version_string};
 pub use world::*;
-
-use status::Failure;
-
-/// Checks that `p` is non-NULL and aligned for `T`; `what` names the argument in messages.
-fn checked_ptr<T>(p: *const T, what: &str) -> Result<*const T, Failure> {
-    if p.is_null() {
-        Err(Failure::null(what))
-    } else if !p.is_aligned() {
-        Err(Failure::invalid(format!(
-            "{what} is not aligned to {} bytes",
-            align_of::<T>()
-        )))
-    } else {
-        Ok(p)
-    }
-}
-
-/// [`checked_ptr`] for pointers the library writes through.
-fn checked_mut_ptr<T>(p: *mut T, what: &str) -> Result<*mut T, Failure> {
-    checked_ptr(p.cast_const(), what).map(|p| p.cast_mut())
-}
-
-/// The caller's array `p[..len]` as a slice, after checking the pointer and the length.
-///
-/// # Safety
-/// When non-NULL, `p` must point to `len` readable, initialised `T`s that no one writes
-/// during the call.
-unsafe fn input_slice<'a, T>(p: *const T, len: usize, what: &str) -> Result<&'a [T], Failure> {
-    let p = checked_ptr(p, what)?;
-    if len
-        .checked_mul(size_of::<T>())
-        .is_none_or(|b| b > isize::MAX as usize)
-    {
-        return Err(Failure::invalid(format!(
-            "{what} is too long ({len} elements)"
-        )));
-    }
-    // SAFETY: non-NULL, aligned, length in range; validity is the caller's promise.
-    Ok(unsafe { std::slice::from_raw_parts(p, len) })
-}
-
-/// The caller's buffer `p[..len]` as a mutable slice; `p` may be NULL only when `len` is 0.
-///
-/// # Safety
-/// When non-NULL, `p` must point to `len` writable `T`s that no one else accesses during
-/// the call.
-unsafe fn output_slice<'a, T>(p: *mut T, len: usize, what: &str) -> Result<&'a mut [T], Failure> {
-    if p.is_null() && len == 0 {
-        return Ok(&mut []);
-    }
-    let p = checked_mut_ptr(p, what)?;
-    if len
-        .checked_mul(size_of::<T>())
-        .is_none_or(|b| b > isize::MAX as usize)
-    {
-        return Err(Failure::invalid(format!(
-            "{what} capacity {len} is too large"
-        )));
-    }
-    // SAFETY: non-NULL, aligned, length in range; validity is the caller's promise.
-    Ok(unsafe { std::slice::from_raw_parts_mut(p, len) })
-}

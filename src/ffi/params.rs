@@ -1,5 +1,6 @@
 //! `PfParams`, the C mirror of [`Params`], with its enums and `pf_params_default`.
 
+use super::checked::Args;
 use super::status::{Failure, PfStatus, status_call};
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use std::ffi::c_int;
@@ -248,11 +249,10 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
 /// `out` must be NULL or point to a writable `PfParams`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_params_default", || {
-        let out = super::checked_mut_ptr(out, "out")?;
-        // SAFETY: `out` is non-NULL and aligned; the caller guarantees it is writable.
-        unsafe { out.write(PfParams::from(&Params::default())) };
-        Ok(())
+        args.write(out, PfParams::from(&Params::default()), "out")
     })
 }
 
@@ -266,13 +266,11 @@ pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
 /// `params` must be NULL or point to a readable and writable `PfParams`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pf_params_calm(params: *mut PfParams) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_params_calm", || {
-        let raw = super::checked_mut_ptr(params, "params")?;
-        // SAFETY: checked non-NULL and aligned; the caller guarantees it is readable.
-        let calm = unsafe { read_params(raw) }?.calm();
-        // SAFETY: as above; the caller guarantees it is writable.
-        unsafe { raw.write(PfParams::from(&calm)) };
-        Ok(())
+        let calm = args.params(params, "params")?.calm();
+        args.write(params, PfParams::from(&calm), "params")
     })
 }
 
@@ -283,9 +281,9 @@ pub unsafe extern "C" fn pf_params_calm(params: *mut PfParams) -> PfStatus {
 /// `params` must be NULL or point to a readable `PfParams`.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pf_params_validate(params: *const PfParams) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
     status_call("pf_params_validate", || {
-        let params = super::checked_ptr(params, "params")?;
-        // SAFETY: checked non-NULL and aligned; the caller guarantees it is readable.
-        unsafe { read_params(params) }.map(drop)
+        args.params(params, "params").map(drop)
     })
 }

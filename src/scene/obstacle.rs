@@ -91,7 +91,9 @@ fn sculpture() -> Result<TriangleMesh, crate::Error> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::boundary::mesh::sample_count_bound;
     use crate::boundary::mesh::sample_poisson_disk;
+    use crate::boundary::mesh::sampling_checks::{R, check_spacing_and_coverage};
     use crate::boundary::winding::{is_closed_and_oriented, is_inside};
 
     #[test]
@@ -170,5 +172,21 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn sculpture_samples_are_spaced_and_cover_its_curved_and_thin_parts() {
+        // The obstacle of the big scene, rotated and moved: curved tubes, a sphere, a fin
+        // 4 cm thick and ears 3 cm thick, with many triangles smaller than r.
+        let mesh = generated("sculpture").unwrap();
+        let moved = crate::boundary::Transform {
+            rotate_deg: [0.0, 37.0, 0.0],
+            translate: [4.0, 0.0, 4.0],
+            ..Default::default()
+        }
+        .apply(&mesh)
+        .unwrap();
+        let samples = check_spacing_and_coverage(&moved);
+        assert!(samples.len() as f64 <= sample_count_bound(&moved, R));
     }
 }

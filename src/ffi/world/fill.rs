@@ -1,0 +1,234 @@
+//! The functions that fill a `PfWorld`: fluid particles, fluid boxes, boundary particles and
+//! box containers, with the checks of counts and vectors they share with the mesh functions.
+
+use super::PfWorld;
+use crate::Vec3;
+use crate::boundary::Aabb;
+use crate::ffi::checked::Args;
+use crate::ffi::status::{Failure, PfStatus, status_call};
+use std::ffi::c_uint;
+
+/// Most particles one call may add (the world's own limit; indices must fit in 32 bits).
+const MAX_PARTICLES_PER_CALL: usize = u32::MAX as usize / 64;
+
+/// Checks a particle count: positive and at most the per-call limit.
+pub(in crate::ffi) fn check_count(count: usize) -> Result<(), Failure> {
+    if count == 0 {
+        Err(Failure::invalid("count must be positive, got 0"))
+    } else if count > MAX_PARTICLES_PER_CALL {
+        Err(Failure::invalid(format!(
+            "count must be at most {MAX_PARTICLES_PER_CALL}, got {count}"
+        )))
+    } else {
+        Ok(())
+    }
+}
+
+/// Reads `count` xyz triples from `xyz` into vectors, reporting allocation failure.
+/// `count` must have passed [`check_count`], so that 3·count fits.
+pub(in crate::ffi) fn read_vectors(
+    args: Args,
+    xyz: *const f32,
+    count: usize,
+    what: &str,
+) -> Result<Vec<Vec3>, Failure> {
+    let floats = args.slice(xyz, 3 * count, what)?;
+    let mut out = Vec::new();
+    out.try_reserve_exact(count)
+        .map_err(|_| Failure::out_of_memory(what))?;
+    out.extend(
+        floats
+            .chunks_exact(3)
+            .map(|c| Vec3::new(c[0].into(), c[1].into(), c[2].into())),
+    );
+    Ok(out)
+}
+
+/// Reads a 3-vector from `p` (3 floats).
+fn read_vec3(args: Args, p: *const f32, what: &str) -> Result<Vec3, Failure> {
+    let v = args.slice(p, 3, what)?;
+    Ok(Vec3::new(v[0].into(), v[1].into(), v[2].into()))
+}
+
+/// Rejects a non-finite 3-vector argument, naming it.
+fn check_finite(v: Vec3, what: &str) -> Result<Vec3, Failure> {
+    if v.iter().all(|c| c.is_finite()) {
+        Ok(v)
+    } else {
+        Err(Failure::invalid(format!(
+            "{what} must be finite, got {:?}",
+            v.as_slice()
+        )))
+    }
+}
+
+/// A world error whose message starts with the Rust argument name `rust`, renamed to the C
+/// argument name `c` (e.g. `positions[3]` → `xyz[3]`).
+fn renamed(error: crate::Error, rust: &str, c: &str) -> Failure {
+    let text = error.to_string();
+    Failure::invalid(match text.strip_prefix(rust) {
+        Some(rest) => format!("{c}{rest}"),
+        None => text,
+    })
+}
+
+/// Adds `count` fluid particles at rest at positions `xyz` (3·count floats: x, y, z per
+/// particle, metres). Particles are numbered in the order they are added across all calls.
+///
+/// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (count 0 or above the limit,
+/// a non-finite coordinate — its index is named — or too many particles in total),
+/// `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `xyz` must be NULL or point to 3·count readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_fluid_particles(
+    world: *mut PfWorld,
+    xyz: *const f32,
+    count: usize,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_fluid_particles", || {
+        add_fluid(args, world, xyz, None, count)
+    })
+}
+
+/// Like `pf_world_add_fluid_particles`, with initial velocities `velocities` (3·count floats,
+/// m/s). `velocities` may be NULL for particles at rest.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `xyz`, and `velocities` unless NULL, must be NULL or point to 3·count readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_fluid_particles_with_velocities(
+    world: *mut PfWorld,
+    xyz: *const f32,
+    velocities: *const f32,
+    count: usize,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_fluid_particles_with_velocities", || {
+        let velocities = (!velocities.is_null()).then_some(velocities);
+        add_fluid(args, world, xyz, velocities, count)
+    })
+}
+
+/// The shared body of the two fluid-adding functions.
+fn add_fluid(
+    args: Args,
+    world: *mut PfWorld,
+    xyz: *const f32,
+    velocities: Option<*const f32>,
+    count: usize,
+) -> Result<(), Failure> {
+    let mut world = args.world(world)?;
+    check_count(count)?;
+    let positions = read_vectors(args, xyz, count, "xyz")?;
+    let velocities = match velocities {
+        Some(v) => Some(read_vectors(args, v, count, "velocities")?),
+        None => None,
+    };
+    world
+        .try_reserve_fluid(count)
+        .map_err(|_| Failure::out_of_memory("fluid particles"))?;
+    world
+        .add_fluid_particles(&positions, velocities.as_deref())
+        .map_err(|e| renamed(e, "positions", "xyz"))
+}
+
+/// Adds a box-shaped lattice of fluid particles with spacing 2r: centres at
+/// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2] (i fastest, then j,
+/// then k, which is also the order the particles are numbered in). `start` is 3 floats (m),
+/// `count` 3 sizes, `velocity` 3 floats (m/s) or NULL for particles at rest.
+///
+/// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a zero count, a product
+/// above the particle limit, non-finite start or velocity), `PF_ERROR_OUT_OF_MEMORY`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `start` and `velocity` must be NULL or point to 3 readable floats, `count` to 3 readable sizes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_fluid_box(
+    world: *mut PfWorld,
+    start: *const f32,
+    count: *const usize,
+    velocity: *const f32,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_fluid_box", || {
+        let mut world = args.world(world)?;
+        let start = check_finite(read_vec3(args, start, "start")?, "start")?;
+        let counts = args.slice(count, 3, "count")?;
+        let counts = [counts[0], counts[1], counts[2]];
+        let velocity = if velocity.is_null() {
+            Vec3::zeros()
+        } else {
+            check_finite(read_vec3(args, velocity, "velocity")?, "velocity")?
+        };
+        let total = counts.iter().try_fold(1usize, |a, &c| a.checked_mul(c));
+        if let Some(n) = total.filter(|&n| n > 0 && n <= MAX_PARTICLES_PER_CALL) {
+            world
+                .try_reserve_fluid(n)
+                .map_err(|_| Failure::out_of_memory("fluid particles"))?;
+        }
+        world.add_fluid_block(start, counts, velocity)?;
+        Ok(())
+    })
+}
+
+/// Adds `count` static boundary particles at `xyz` (3·count floats, metres), e.g. samples of
+/// an obstacle's surface with spacing about r. Boundary particles never move.
+///
+/// Errors: as `pf_world_add_fluid_particles`.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `xyz` must be NULL or point to 3·count readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_boundary_particles(
+    world: *mut PfWorld,
+    xyz: *const f32,
+    count: usize,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_boundary_particles", || {
+        let mut world = args.world(world)?;
+        check_count(count)?;
+        let positions = read_vectors(args, xyz, count, "xyz")?;
+        world
+            .try_reserve_boundary(count)
+            .map_err(|_| Failure::out_of_memory("boundary particles"))?;
+        world
+            .add_boundary_particles(&positions)
+            .map_err(|e| renamed(e, "positions", "xyz"))
+    })
+}
+
+/// Adds a closed box container from corner `min` to corner `max` (3 floats each, metres):
+/// its six walls are sampled with boundary particles, `layers` (1–3) layers thick, growing
+/// outward. Fluid farther than r/2 outside every container counts as escaped.
+///
+/// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
+/// shorter than two particle spacings or inverted, layers outside 1–3, a box needing too
+/// many particles).
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_container_box(
+    world: *mut PfWorld,
+    min: *const f32,
+    max: *const f32,
+    layers: c_uint,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_container_box", || {
+        let mut world = args.world(world)?;
+        let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
+        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
+        world.add_container(Aabb { min, max }, layers as usize)?;
+        Ok(())
+    })
+}

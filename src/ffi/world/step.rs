@@ -1,0 +1,78 @@
+//! The functions that advance a `PfWorld` in time: one step, a span of simulated time, and
+//! a damped relaxation towards equilibrium.
+
+use super::PfWorld;
+use crate::ffi::checked::Args;
+use crate::ffi::status::{Failure, PfStatus, status_call};
+
+/// Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
+/// `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
+///
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite or above 1; no fluid particles).
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_step(world: *mut PfWorld, dt: f64) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_step", || {
+        let mut world = args.world(world)?;
+        if !dt.is_finite() {
+            return Err(Failure::invalid(format!(
+                "dt must be finite (≤ 0 for the CFL step), got {dt}"
+            )));
+        }
+        if dt <= 0.0 {
+            world.step()?;
+        } else {
+            world.step_with_dt(dt)?;
+        }
+        Ok(())
+    })
+}
+
+/// Takes CFL-limited steps until `seconds` more simulated time has passed (the last step
+/// is shortened to land exactly). 0 takes no step.
+///
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative or not finite; no fluid particles
+/// while seconds > 0).
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_advance(world: *mut PfWorld, seconds: f64) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_advance", || {
+        let mut world = args.world(world)?;
+        world.advance(seconds)?;
+        Ok(())
+    })
+}
+
+/// Relaxes the fluid towards its equilibrium: takes CFL-limited steps like
+/// `pf_world_advance` for `seconds`, and after every step of Δt scales every fluid velocity
+/// by exp(−`damping`·Δt) (`damping` in 1/s; 0 is `pf_world_advance`). A block of particles
+/// on a lattice is not at rest under gravity; 10 s at 4/s bring a tank to its equilibrium
+/// packing, from which it stays at rest under the calm settings (`pf_params_calm`).
+///
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds or damping negative or not finite; no fluid
+/// particles while seconds > 0), taking no step.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_relax(
+    world: *mut PfWorld,
+    seconds: f64,
+    damping: f64,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_relax", || {
+        let mut world = args.world(world)?;
+        world.relax(seconds, damping)?;
+        Ok(())
+    })
+}

@@ -1,84 +1,29 @@
 //! The solver benchmark of the paper's Table 1: every scene with every global solver, the same
 //! parameters and stopping rule, the first N steps; a table of cost, accuracy and an
 //! "artifacts" verdict, written as Markdown and CSV, and bar charts of time and iterations.
+//!
+//! The runs live here; the artifacts rule, the table and the charts live in submodules.
+
+mod artifacts;
+mod charts;
+mod table;
+
+pub(crate) use artifacts::above;
+pub use artifacts::{
+    AVG_DENSITY_ERROR_LIMIT_PERCENT, Artifact, ENERGY_RISE_LIMIT, MAX_DENSITY_ERROR_LIMIT_PERCENT,
+    artifacts,
+};
+pub use charts::charts;
+pub use table::{csv, markdown};
 
 use crate::driver::{RunError, RunLength, Runner};
-use crate::plot::BarChart;
 use crate::summary::RunSummary;
-use crate::table::{self, Cell, Column};
 use projfluid::scene::Scene;
 use projfluid::{Error, SolverKind};
 use std::convert::Infallible;
-use std::fmt;
 
 /// The paper's protocol: the mean over the first 80 time steps.
 pub const DEFAULT_STEPS: u64 = 80;
-
-/// A run "has artifacts" when its mean density error exceeds this (percent; docs/method.md §10.1
-/// asks for ≲ 0.1 %).
-pub const AVG_DENSITY_ERROR_LIMIT_PERCENT: f64 = 0.1;
-/// … or its largest density error exceeds this (percent; the upper end of the ≲ 1–3 % of
-/// docs/method.md §10.1).
-pub const MAX_DENSITY_ERROR_LIMIT_PERCENT: f64 = 3.0;
-/// … or its total energy ever rose above the initial value by more than this fraction of it
-/// (implicit Euler and XSPH only dissipate, so a converged run never rises at all).
-pub const ENERGY_RISE_LIMIT: f64 = 0.01;
-
-/// One reason a run counts as having artifacts.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Artifact {
-    /// This many particles had a non-finite position or velocity.
-    NotFinite(usize),
-    /// This many particles left the container.
-    Escaped(usize),
-    /// Mean density error (percent) above [`AVG_DENSITY_ERROR_LIMIT_PERCENT`].
-    AverageDensityError(f64),
-    /// Largest density error (percent) above [`MAX_DENSITY_ERROR_LIMIT_PERCENT`].
-    MaxDensityError(f64),
-    /// Total energy rose above its initial value by this fraction (above [`ENERGY_RISE_LIMIT`]).
-    EnergyRise(f64),
-}
-
-impl fmt::Display for Artifact {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match self {
-            Artifact::NotFinite(n) => write!(f, "{n} NaN"),
-            Artifact::Escaped(n) => write!(f, "{n} escaped"),
-            Artifact::AverageDensityError(p) => write!(f, "avg density error {p:.3} %"),
-            Artifact::MaxDensityError(p) => write!(f, "max density error {p:.2} %"),
-            Artifact::EnergyRise(x) => write!(f, "energy +{:.2} %", x * 100.0),
-        }
-    }
-}
-
-/// The artifacts rule: every limit a run broke (empty when none). A non-finite statistic
-/// counts as broken.
-pub fn artifacts(s: &RunSummary) -> Vec<Artifact> {
-    let mut found = Vec::new();
-    if s.nan > 0 {
-        found.push(Artifact::NotFinite(s.nan));
-    }
-    if s.escaped > 0 {
-        found.push(Artifact::Escaped(s.escaped));
-    }
-    if above(s.density_error_avg_percent, AVG_DENSITY_ERROR_LIMIT_PERCENT) {
-        found.push(Artifact::AverageDensityError(s.density_error_avg_percent));
-    }
-    if above(s.density_error_max_percent, MAX_DENSITY_ERROR_LIMIT_PERCENT) {
-        found.push(Artifact::MaxDensityError(s.density_error_max_percent));
-    }
-    if let Some(rise) = s.energy_rise()
-        && above(rise, ENERGY_RISE_LIMIT)
-    {
-        found.push(Artifact::EnergyRise(rise));
-    }
-    found
-}
-
-/// `value` exceeds `limit`, or is NaN (a broken statistic never passes a limit).
-pub(crate) fn above(value: f64, limit: f64) -> bool {
-    value.is_nan() || value > limit
-}
 
 /// One scene run with one solver.
 #[derive(Clone, Debug, PartialEq)]
@@ -201,141 +146,12 @@ fn run_in_turns(
     Ok(rows)
 }
 
-/// The columns of [`markdown`] and [`csv`].
-const COLUMNS: [Column<BenchRow>; 14] = [
-    Column {
-        title: "scene",
-        key: "scene",
-        cell: |r| Cell::Text(r.summary.scene.clone()),
-    },
-    Column {
-        title: "solver",
-        key: "solver",
-        cell: |r| Cell::Text(r.summary.solver.clone()),
-    },
-    Column {
-        title: "particles",
-        key: "particles",
-        cell: |r| Cell::Number(r.summary.particles as f64, 0),
-    },
-    Column {
-        title: "threads",
-        key: "threads",
-        cell: |r| Cell::Number(r.summary.threads as f64, 0),
-    },
-    Column {
-        title: "steps",
-        key: "steps",
-        cell: |r| Cell::Number(r.summary.steps as f64, 0),
-    },
-    Column {
-        title: "ms / step",
-        key: "ms_per_step",
-        cell: |r| Cell::Number(r.summary.wall_ms_per_step, 1),
-    },
-    Column {
-        title: "CPU ms / step",
-        key: "cpu_ms_per_step",
-        cell: |r| Cell::Number(r.summary.cpu_ms_per_step.unwrap_or(f64::NAN), 1),
-    },
-    Column {
-        title: "outer it. / step",
-        key: "outer_iterations_mean",
-        cell: |r| Cell::Number(r.summary.outer_iterations_mean, 2),
-    },
-    Column {
-        title: "inner it. / step",
-        key: "inner_iterations_mean",
-        cell: |r| Cell::Number(r.summary.inner_iterations_mean, 2),
-    },
-    Column {
-        title: "K_max hits",
-        key: "max_iteration_hits",
-        cell: |r| Cell::Number(r.summary.max_iteration_hits as f64, 0),
-    },
-    Column {
-        title: "avg density error %",
-        key: "density_error_avg_percent",
-        cell: |r| Cell::Number(r.summary.density_error_avg_percent, 4),
-    },
-    Column {
-        title: "max density error %",
-        key: "density_error_max_percent",
-        cell: |r| Cell::Number(r.summary.density_error_max_percent, 3),
-    },
-    Column {
-        title: "energy rise %",
-        key: "energy_rise_percent",
-        cell: |r| Cell::Number(r.energy_rise_percent(), 2),
-    },
-    Column {
-        title: "artifacts",
-        key: "artifacts",
-        cell: |r| Cell::Text(r.verdict()),
-    },
-];
-
-/// The table as GitHub Markdown, one row per run.
-pub fn markdown(rows: &[BenchRow]) -> String {
-    table::markdown(&COLUMNS, rows)
-}
-
-/// The table as CSV (header line of keys, numbers in full precision).
-pub fn csv(rows: &[BenchRow]) -> String {
-    table::csv(&COLUMNS, rows)
-}
-
-/// The table as two bar charts, one group of bars per scene and one bar per solver: wall-clock
-/// milliseconds per step, and outer iterations per step.
-pub fn charts(rows: &[BenchRow]) -> [BarChart; 2] {
-    let mut scenes: Vec<String> = Vec::new();
-    let mut solvers: Vec<String> = Vec::new();
-    for row in rows {
-        for (list, name) in [
-            (&mut scenes, &row.summary.scene),
-            (&mut solvers, &row.summary.solver),
-        ] {
-            if !list.contains(name) {
-                list.push(name.clone());
-            }
-        }
-    }
-    let chart = |title: &str, y_label: &str, value: fn(&RunSummary) -> f64| BarChart {
-        title: title.to_string(),
-        y_label: y_label.to_string(),
-        categories: scenes.clone(),
-        series: solvers
-            .iter()
-            .map(|solver| {
-                let values = scenes
-                    .iter()
-                    .map(|scene| {
-                        rows.iter()
-                            .find(|r| &r.summary.scene == scene && &r.summary.solver == solver)
-                            .map_or(f64::NAN, |r| value(&r.summary))
-                    })
-                    .collect();
-                (solver.clone(), values)
-            })
-            .collect(),
-    };
-    [
-        chart("Time per step", "ms per step (wall clock)", |s| {
-            s.wall_ms_per_step
-        }),
-        chart(
-            "Outer iterations per step",
-            "outer iterations per step",
-            |s| s.outer_iterations_mean,
-        ),
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn clean() -> RunSummary {
+    /// A run that breaks no limit.
+    pub(super) fn clean() -> RunSummary {
         RunSummary {
             scene: "s".into(),
             solver: "jacobi1".into(),
@@ -346,30 +162,6 @@ mod tests {
             energy_final: 90.0,
             ..RunSummary::default()
         }
-    }
-
-    #[test]
-    fn artifacts_rule_flags_each_broken_limit() {
-        assert!(artifacts(&clean()).is_empty());
-        let broken = RunSummary {
-            nan: 2,
-            escaped: 3,
-            density_error_avg_percent: 0.2,
-            density_error_max_percent: f64::NAN,
-            energy_max: 101.5,
-            ..clean()
-        };
-        let found = artifacts(&broken);
-        assert_eq!(found.len(), 5, "{found:?}");
-        assert_eq!(found[4], Artifact::EnergyRise(0.015));
-        let row = BenchRow {
-            summary: broken,
-            artifacts: found,
-        };
-        assert!(
-            row.verdict()
-                .starts_with("2 NaN; 3 escaped; avg density error 0.200 %")
-        );
     }
 
     /// Taking turns changes no result but the times: every world steps as it would alone,
@@ -423,26 +215,5 @@ mod tests {
             );
             assert_eq!(events[3..], ["done chebyshev", "done cg", "done jacobi1"]);
         }
-    }
-
-    #[test]
-    fn tables_have_one_line_per_row_and_matching_columns() {
-        let rows = vec![
-            BenchRow {
-                summary: clean(),
-                artifacts: vec![],
-            };
-            2
-        ];
-        let md = markdown(&rows);
-        assert_eq!(md.lines().count(), 4);
-        assert!(
-            md.lines()
-                .all(|l| l.matches('|').count() == COLUMNS.len() + 1)
-        );
-        let csv = csv(&rows);
-        assert_eq!(csv.lines().count(), 3);
-        assert!(csv.lines().all(|l| l.split(',').count() == COLUMNS.len()));
-        assert!(csv.lines().nth(1).unwrap().ends_with(",0,none"));
     }
 }

@@ -2,97 +2,23 @@
 //! spheres (lit, darker with depth), coloured by speed, obstacle particles drawn as a faint
 //! translucent grey, container boxes as faint edges, seen by a fixed perspective camera
 //! framed on the containers. Written as 8-bit RGB PNG files with the `png` crate.
+//!
+//! This module holds the renderer and the composition of a frame; the camera and its
+//! projection, the drawing of spheres and lines, the colours and the image live in its
+//! submodules.
 
+mod camera;
+mod colour;
+mod image;
+mod raster;
+
+pub use camera::Camera;
+pub use image::Image;
+
+use camera::View;
+use colour::{background, speed_colour};
 use projfluid::boundary::Aabb;
-use projfluid::{Error, Vec3, World};
-use std::path::Path;
-
-/// A perspective camera (metres, degrees).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Camera {
-    /// Position of the eye (m).
-    pub eye: Vec3,
-    /// The point seen at the centre of the image (m).
-    pub target: Vec3,
-    /// Vertical field of view (degrees).
-    pub fov_y_deg: f64,
-}
-
-impl Camera {
-    /// A camera above (+y) the box `bounds`, looking at its centre from as close as lets
-    /// the whole box fit in an image of aspect ratio `aspect` (width / height): in front of
-    /// (+z) and to the right of (+x) a box longer than deep, from the (+x, −z) corner along
-    /// the diagonal a box about as deep as long (whose x = z diagonal then runs across the
-    /// picture, so that things in opposite corners do not hide its middle).
-    pub fn framing(bounds: &Aabb, aspect: f64) -> Camera {
-        let fov_y_deg: f64 = 35.0;
-        let centre = (bounds.min + bounds.max) * 0.5;
-        let size = bounds.max - bounds.min;
-        let back = if size.z > 0.6 * size.x {
-            Vec3::new(1.0, 0.9, -1.0).normalize()
-        } else {
-            Vec3::new(0.45, 0.55, 1.0).normalize()
-        };
-        let right = Vec3::y().cross(&back).normalize();
-        let up = back.cross(&right);
-        let tan_y = (fov_y_deg.to_radians() * 0.5).tan();
-        let tan_x = tan_y * aspect.max(1e-3);
-        // The nearest distance at which every corner projects inside the image.
-        let half = (bounds.max - bounds.min) * 0.5;
-        let distance = (0..8)
-            .map(|i| {
-                let o = Vec3::new(
-                    if i & 1 == 0 { -half.x } else { half.x },
-                    if i & 2 == 0 { -half.y } else { half.y },
-                    if i & 4 == 0 { -half.z } else { half.z },
-                );
-                o.dot(&back) + (o.dot(&right).abs() / tan_x).max(o.dot(&up).abs() / tan_y)
-            })
-            .fold(1e-6, f64::max);
-        Camera {
-            eye: centre + back * (1.08 * distance),
-            target: centre,
-            fov_y_deg,
-        }
-    }
-}
-
-/// An 8-bit RGB image, rows top to bottom.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Image {
-    /// Width in pixels.
-    pub width: usize,
-    /// Height in pixels.
-    pub height: usize,
-    /// `width·height` pixels, row by row from the top.
-    pub pixels: Vec<[u8; 3]>,
-}
-
-impl Image {
-    /// The pixel in column `x` and row `y` (from the top).
-    pub fn pixel(&self, x: usize, y: usize) -> [u8; 3] {
-        self.pixels[y * self.width + x]
-    }
-
-    /// Writes the image as an 8-bit RGB PNG file; errors name the path.
-    pub fn write_png(&self, path: &Path) -> Result<(), Error> {
-        let fail = |e: String| Error::Io(format!("cannot write {}: {e}", path.display()));
-        let file = std::fs::File::create(path).map_err(|e| fail(e.to_string()))?;
-        let mut encoder = png::Encoder::new(
-            std::io::BufWriter::new(file),
-            self.width as u32,
-            self.height as u32,
-        );
-        encoder.set_color(png::ColorType::Rgb);
-        encoder.set_depth(png::BitDepth::Eight);
-        let mut writer = encoder.write_header().map_err(|e| fail(e.to_string()))?;
-        let data: Vec<u8> = self.pixels.iter().flatten().copied().collect();
-        writer
-            .write_image_data(&data)
-            .map_err(|e| fail(e.to_string()))?;
-        writer.finish().map_err(|e| fail(e.to_string()))
-    }
-}
+use projfluid::{Vec3, World};
 
 /// What to draw and how: image size, camera, particle size and the speed colour scale.
 #[derive(Clone, Debug, PartialEq)]
@@ -119,70 +45,6 @@ pub struct Frame<'a> {
     pub obstacle: &'a [Vec3],
     /// Container boxes, drawn as faint edges.
     pub containers: &'a [Aabb],
-}
-
-/// Camera coordinates of a point: right, up, and depth along the view direction (m).
-struct View {
-    eye: Vec3,
-    right: Vec3,
-    up: Vec3,
-    forward: Vec3,
-    focal: f64,
-    centre: (f64, f64),
-}
-
-impl View {
-    fn new(r: &Renderer) -> Self {
-        let c = &r.camera;
-        let forward = (c.target - c.eye).normalize();
-        let right = forward.cross(&Vec3::y()).normalize();
-        let up = right.cross(&forward);
-        let focal = 0.5 * r.height as f64 / (c.fov_y_deg.to_radians() * 0.5).tan();
-        Self {
-            eye: c.eye,
-            right,
-            up,
-            forward,
-            focal,
-            centre: (0.5 * r.width as f64, 0.5 * r.height as f64),
-        }
-    }
-
-    /// Screen position (pixels, y down) and depth (m) of `p`; `None` behind the eye.
-    fn project(&self, p: &Vec3) -> Option<(f64, f64, f64)> {
-        let q = p - self.eye;
-        let z = q.dot(&self.forward);
-        (z > 1e-6).then(|| {
-            (
-                self.centre.0 + q.dot(&self.right) / z * self.focal,
-                self.centre.1 - q.dot(&self.up) / z * self.focal,
-                z,
-            )
-        })
-    }
-}
-
-/// Background: a vertical gradient from dark slate (top) to near black (bottom).
-fn background(y: usize, height: usize) -> [f64; 3] {
-    let t = y as f64 / height.max(2) as f64;
-    let top = [0.16, 0.18, 0.22];
-    let bottom = [0.05, 0.05, 0.07];
-    std::array::from_fn(|k| top[k] + (bottom[k] - top[k]) * t)
-}
-
-/// Speed colour scale: deep blue, light blue, white, orange, red at t = 0, ¼, ½, ¾, 1.
-fn speed_colour(t: f64) -> [f64; 3] {
-    const STOPS: [[f64; 3]; 5] = [
-        [0.05, 0.25, 0.75],
-        [0.25, 0.65, 0.95],
-        [0.92, 0.95, 0.97],
-        [1.0, 0.65, 0.2],
-        [0.85, 0.15, 0.1],
-    ];
-    let x = t.clamp(0.0, 1.0) * 4.0;
-    let i = (x.floor() as usize).min(3);
-    let f = x - i as f64;
-    std::array::from_fn(|k| STOPS[i][k] + (STOPS[i + 1][k] - STOPS[i][k]) * f)
 }
 
 impl Renderer {
@@ -284,85 +146,14 @@ impl Renderer {
                 .collect(),
         }
     }
-
-    /// Draws a sphere of the particle radius at `p` into the pixels whose centres it covers
-    /// and where it is nearer than `depth`; `shade(nx, ny, nz, z)` gives the colour from the
-    /// sphere's normal in camera space (x right, y up, z towards the eye) and the depth.
-    fn splat(
-        &self,
-        view: &View,
-        p: &Vec3,
-        depth: &mut [f64],
-        shade: impl Fn(f64, f64, f64, f64) -> [f64; 3],
-        rgb: &mut [[f64; 3]],
-    ) {
-        let Some((sx, sy, z)) = view.project(p) else {
-            return;
-        };
-        let radius = (self.particle_radius * view.focal / z).max(0.75);
-        let (w, h) = (self.width as isize, self.height as isize);
-        let x0 = ((sx - radius).floor() as isize).max(0);
-        let x1 = ((sx + radius).ceil() as isize).min(w - 1);
-        let y0 = ((sy - radius).floor() as isize).max(0);
-        let y1 = ((sy + radius).ceil() as isize).min(h - 1);
-        for y in y0..=y1 {
-            for x in x0..=x1 {
-                let dx = (x as f64 + 0.5 - sx) / radius;
-                let dy = (y as f64 + 0.5 - sy) / radius;
-                let d2 = dx * dx + dy * dy;
-                if d2 > 1.0 {
-                    continue;
-                }
-                let nz = (1.0 - d2).sqrt();
-                let surface = z - nz * self.particle_radius;
-                let i = (y * w + x) as usize;
-                if surface < depth[i] {
-                    depth[i] = surface;
-                    rgb[i] = shade(dx, -dy, nz, z);
-                }
-            }
-        }
-    }
-
-    /// The twelve edges of `b`, blended at 25 % white.
-    fn draw_box_edges(&self, view: &View, b: &Aabb, rgb: &mut [[f64; 3]]) {
-        let corner = |i: usize| {
-            Vec3::new(
-                if i & 1 == 0 { b.min.x } else { b.max.x },
-                if i & 2 == 0 { b.min.y } else { b.max.y },
-                if i & 4 == 0 { b.min.z } else { b.max.z },
-            )
-        };
-        for i in 0..8 {
-            for bit in [1, 2, 4] {
-                if i & bit == 0 {
-                    self.draw_line(view, &corner(i), &corner(i | bit), rgb);
-                }
-            }
-        }
-    }
-
-    fn draw_line(&self, view: &View, a: &Vec3, b: &Vec3, rgb: &mut [[f64; 3]]) {
-        let (Some(p), Some(q)) = (view.project(a), view.project(b)) else {
-            return;
-        };
-        let steps = ((q.0 - p.0).abs().max((q.1 - p.1).abs()).ceil() as usize).clamp(1, 1 << 16);
-        for s in 0..=steps {
-            let t = s as f64 / steps as f64;
-            let (x, y) = (p.0 + (q.0 - p.0) * t, p.1 + (q.1 - p.1) * t);
-            if x >= 0.0 && y >= 0.0 && (x as usize) < self.width && (y as usize) < self.height {
-                let i = y as usize * self.width + x as usize;
-                rgb[i] = rgb[i].map(|c| 0.75 * c + 0.25);
-            }
-        }
-    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn renderer() -> Renderer {
+    /// A 160 × 90 renderer framed on a 2 × 1 × 1 m box.
+    pub(super) fn renderer() -> Renderer {
         let bounds = Aabb {
             min: Vec3::zeros(),
             max: Vec3::new(2.0, 1.0, 1.0),
@@ -376,7 +167,8 @@ mod tests {
         }
     }
 
-    fn background_pixel(y: usize, h: usize) -> [u8; 3] {
+    /// The background of row `y` in an image `h` pixels high, as stored.
+    pub(super) fn background_pixel(y: usize, h: usize) -> [u8; 3] {
         background(y, h).map(|x| (x * 255.0).round() as u8)
     }
 
@@ -489,64 +281,5 @@ mod tests {
             let (x, y, _) = view.project(&corner).unwrap();
             assert!(x > 0.0 && x < r.width as f64 && y > 0.0 && y < r.height as f64);
         }
-    }
-
-    #[test]
-    fn square_tanks_are_seen_from_a_corner_and_fit() {
-        let bounds = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::new(8.0, 5.0, 8.0),
-        };
-        let r = Renderer {
-            camera: Camera::framing(&bounds, 16.0 / 9.0),
-            ..renderer()
-        };
-        let (eye, target) = (r.camera.eye, r.camera.target);
-        assert!(
-            eye.x > target.x && eye.z < target.z && eye.y > target.y,
-            "{eye:?}"
-        );
-        let view = View::new(&r);
-        let mut widest = 0.0f64;
-        for i in 0..8 {
-            let corner = Vec3::new(
-                if i & 1 == 0 { 0.0 } else { 8.0 },
-                if i & 2 == 0 { 0.0 } else { 5.0 },
-                if i & 4 == 0 { 0.0 } else { 8.0 },
-            );
-            let (x, y, _) = view.project(&corner).unwrap();
-            assert!(x > 0.0 && x < r.width as f64 && y > 0.0 && y < r.height as f64);
-            widest = widest.max((x - r.width as f64 / 2.0).abs() / (r.width as f64 / 2.0));
-            widest = widest.max((y - r.height as f64 / 2.0).abs() / (r.height as f64 / 2.0));
-        }
-        // Framed closely: some corner comes near the edge of the picture.
-        assert!(widest > 0.85, "{widest}");
-    }
-
-    #[test]
-    fn png_files_read_back() {
-        let r = renderer();
-        let image = r.render(&Frame {
-            positions: &[r.camera.target],
-            velocities: &[Vec3::zeros()],
-            obstacle: &[],
-            containers: &[],
-        });
-        let path =
-            std::env::temp_dir().join(format!("projfluid-render-{}.png", std::process::id()));
-        image.write_png(&path).unwrap();
-        let decoder = png::Decoder::new(std::fs::File::open(&path).unwrap());
-        let mut reader = decoder.read_info().unwrap();
-        let mut buf = vec![0; reader.output_buffer_size()];
-        let info = reader.next_frame(&mut buf).unwrap();
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!((info.width, info.height), (160, 90));
-        assert_eq!(info.color_type, png::ColorType::Rgb);
-        let back: Vec<u8> = image.pixels.iter().flatten().copied().collect();
-        assert_eq!(&buf[..info.buffer_size()], &back[..]);
-        let err = image
-            .write_png(Path::new("/nonexistent/x.png"))
-            .unwrap_err();
-        assert!(err.to_string().contains("/nonexistent/x.png"), "{err}");
     }
 }

@@ -115,3 +115,40 @@ fn dam_break(
         output: OutputSpec::default(),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    #[test]
+    fn builtin_files_match_builtins() {
+        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        for name in Scene::builtin_names() {
+            let loaded = Scene::load(&dir.join(format!("{name}.json"))).unwrap();
+            assert_eq!(Some(loaded), Scene::builtin(name), "{name}");
+        }
+    }
+
+    #[test]
+    fn builtins_are_valid_and_sized_as_named() {
+        assert!(Scene::builtin("nope").is_none());
+        for name in Scene::builtin_names() {
+            let scene = Scene::builtin(name).unwrap();
+            scene.validate().unwrap();
+            assert_eq!(&scene.name, name);
+        }
+        for (name, count) in [
+            ("dam_break_30k", 30_000),
+            ("dam_break_88k", 88_236),
+            ("double_dam_break_128k", 128_000),
+            ("obstacle_298k", 297_754),
+        ] {
+            assert_eq!(Scene::builtin(name).unwrap().particle_count(), count);
+        }
+        // One particle radius across scenes (docs/method.md §9).
+        for name in Scene::builtin_names() {
+            assert_eq!(Scene::builtin(name).unwrap().params.particle_radius, 0.025);
+        }
+    }
+}

@@ -1,10 +1,18 @@
-//! The JSON form of a scene: serde structures mirroring docs/scene-format.md, their
-//! conversion to and from [`Scene`], and a printer that keeps number arrays on one line.
+//! The JSON form of a scene: serde structures mirroring docs/scene-format.md and their
+//! conversion to and from [`Scene`].
 
-use super::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};
+mod error;
+mod obstacles;
+mod print;
+#[cfg(test)]
+mod tests;
+
+use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
 use crate::Error;
-use crate::boundary::Transform;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+use error::json_error;
+use obstacles::ObstacleFile;
+use print::inline_number_arrays;
 use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
 use serde::de::{MapAccess, SeqAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
@@ -66,90 +74,6 @@ struct TimeFile {
 struct OutputFile {
     dir: Option<String>,
     every: Option<usize>,
-}
-
-/// One entry of `obstacles`: a mesh source and its placement.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ObstacleFile {
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    obj: Option<String>,
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    generated: Option<String>,
-    scale: Option<Scale>,
-    rotate_deg: Option<[f64; 3]>,
-    translate: Option<[f64; 3]>,
-}
-
-/// `scale`: one factor for all axes, or one per axis.
-#[derive(Serialize, Deserialize, Clone, Copy)]
-#[serde(untagged)]
-enum Scale {
-    Uniform(f64),
-    PerAxis([f64; 3]),
-}
-
-impl ObstacleFile {
-    /// The obstacle, with a relative `obj` path taken relative to `base` (the scene file's
-    /// directory, if any). `i` names the entry in errors.
-    fn into_spec(self, i: usize, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
-        let mesh = match (self.obj, self.generated) {
-            (Some(obj), None) => {
-                let path = PathBuf::from(obj);
-                MeshSource::Obj(match base {
-                    Some(dir) if path.is_relative() => dir.join(path),
-                    _ => path,
-                })
-            }
-            (None, Some(name)) => MeshSource::Generated(name),
-            _ => {
-                return Err(Error::InvalidArgument {
-                    field: format!("obstacles[{i}]"),
-                    message: format!(
-                        "obstacles[{i}] needs exactly one mesh: `obj` (an OBJ file path) or \
-                         `generated` (one of {})",
-                        super::obstacle::NAMES.join(", ")
-                    ),
-                });
-            }
-        };
-        let identity = Transform::default();
-        Ok(ObstacleSpec {
-            mesh,
-            transform: Transform {
-                scale: match self.scale {
-                    None => identity.scale,
-                    Some(Scale::Uniform(s)) => [s; 3],
-                    Some(Scale::PerAxis(s)) => s,
-                },
-                rotate_deg: self.rotate_deg.unwrap_or(identity.rotate_deg),
-                translate: self.translate.unwrap_or(identity.translate),
-            },
-        })
-    }
-
-    /// Every key written out.
-    fn from_spec(spec: &ObstacleSpec) -> Self {
-        let t = &spec.transform;
-        let [x, y, z] = t.scale;
-        ObstacleFile {
-            obj: match &spec.mesh {
-                MeshSource::Obj(path) => Some(path.to_string_lossy().into_owned()),
-                MeshSource::Generated(_) => None,
-            },
-            generated: match &spec.mesh {
-                MeshSource::Generated(name) => Some(name.clone()),
-                MeshSource::Obj(_) => None,
-            },
-            scale: Some(if x == y && y == z {
-                Scale::Uniform(x)
-            } else {
-                Scale::PerAxis(t.scale)
-            }),
-            rotate_deg: Some(t.rotate_deg),
-            translate: Some(t.translate),
-        }
-    }
 }
 
 /// `solver.rho`: a number in [0, 1), or `"auto"` for the online estimate.
@@ -237,45 +161,6 @@ pub(super) fn parse(text: &str, origin: Option<&Path>, default_name: &str) -> Re
         .and_then(|f| de.end().map(|()| f).map_err(|e| json_error(e, ".", origin)))?;
     let base = origin.and_then(Path::parent);
     file.into_scene(default_name, base)
-}
-
-/// A JSON error as "FILE: line L column C: PATH: MESSAGE".
-fn json_error(e: serde_json::Error, path: &str, origin: Option<&Path>) -> Error {
-    let (line, column) = (e.line(), e.column());
-    let mut message = e.to_string();
-    let suffix = format!(" at line {line} column {column}");
-    if let Some(stripped) = message.strip_suffix(&suffix) {
-        message = stripped.to_string();
-    }
-    let syntax = e.is_syntax() || e.is_eof();
-    // An unknown key's path ends with the key itself; name the object that holds it instead.
-    let mut path = path;
-    if let Some(key) = message
-        .strip_prefix("unknown field `")
-        .and_then(|rest| rest.split('`').next())
-        && let Some(parent) = path.strip_suffix(key)
-    {
-        path = parent.strip_suffix('.').unwrap_or(".");
-        if path.is_empty() {
-            path = ".";
-        }
-    }
-    let field = if syntax || path == "." { "scene" } else { path };
-    let mut out = String::new();
-    if let Some(p) = origin {
-        out.push_str(&format!("{}: ", p.display()));
-    }
-    out.push_str(&format!("line {line} column {column}: "));
-    if syntax {
-        out.push_str("invalid JSON: ");
-    } else if path != "." {
-        out.push_str(&format!("{path}: "));
-    }
-    out.push_str(&message);
-    Error::InvalidArgument {
-        field: field.to_string(),
-        message: out,
-    }
 }
 
 impl SceneFile {
@@ -402,46 +287,4 @@ pub(super) fn to_json(scene: &Scene) -> String {
         .or_else(|_| serde_json::to_string(&file))
         .unwrap_or_default();
     inline_number_arrays(&pretty)
-}
-
-/// Rewrites every array that holds no string, object or array onto one line.
-fn inline_number_arrays(json: &str) -> String {
-    let bytes = json.as_bytes();
-    let mut out = String::with_capacity(json.len());
-    let (mut i, mut in_string, mut escaped) = (0, false, false);
-    while i < bytes.len() {
-        let b = bytes[i];
-        if in_string {
-            if escaped {
-                escaped = false;
-            } else if b == b'\\' {
-                escaped = true;
-            } else if b == b'"' {
-                in_string = false;
-            }
-        } else if b == b'"' {
-            in_string = true;
-        } else if b == b'[' {
-            let rest = &json[i + 1..];
-            if let Some(end) = rest.find([']', '[', '{', '"'])
-                && rest.as_bytes()[end] == b']'
-            {
-                let items: Vec<&str> = rest[..end]
-                    .split(',')
-                    .map(str::trim)
-                    .filter(|s| !s.is_empty())
-                    .collect();
-                out.push('[');
-                out.push_str(&items.join(", "));
-                out.push(']');
-                i += end + 2;
-                continue;
-            }
-        }
-        // Copy the whole UTF-8 character starting here.
-        let len = json[i..].chars().next().map_or(1, char::len_utf8);
-        out.push_str(&json[i..i + len]);
-        i += len;
-    }
-    out
 }

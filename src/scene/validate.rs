@@ -252,3 +252,96 @@ fn short(x: f64) -> String {
         s.to_string()
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use crate::scene::Scene;
+    use crate::scene::test_support::{GOOD, assert_names, message};
+
+    #[test]
+    fn negative_radius_names_field_and_value() {
+        let text = GOOD.replace("\"particle_radius\": 0.05", "\"particle_radius\": -0.1");
+        assert_eq!(
+            message(Scene::from_json(&text)),
+            "particle_radius must be a positive finite number, got -0.1"
+        );
+    }
+
+    #[test]
+    fn empty_fluid_blocks_is_an_error() {
+        let text = r#"{"particle_radius": 0.05, "duration": 1, "fluid_blocks": []}"#;
+        assert_names(&message(Scene::from_json(text)), &["fluid_blocks", "empty"]);
+    }
+
+    #[test]
+    fn fluid_outside_the_container_is_an_error() {
+        let text = GOOD.replace("\"start\": [0.1, 1.0, 0.1]", "\"start\": [0.1, 2.9, 0.1]");
+        let msg = message(Scene::from_json(&text));
+        assert_eq!(
+            msg,
+            "fluid_blocks[1] lies outside the container: max y 3.1 > container max 3.0"
+        );
+        let text = GOOD.replace("\"start\": [0.1, 0.1, 0.1]", "\"start\": [-0.1, 0.1, 0.1]");
+        assert_names(
+            &message(Scene::from_json(&text)),
+            &["fluid_blocks[0]", "min x -0.1 < container min 0.0"],
+        );
+    }
+
+    #[test]
+    fn fluid_may_straddle_two_containers_but_not_leave_both() {
+        let two = r#"{"particle_radius": 0.05, "duration": 1,
+            "container": [{"min": [0, 0, 0], "max": [1, 1, 1]}, {"min": [1, 0, 0], "max": [2, 1, 1]}],
+            "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [15, 2, 2]}]}"#;
+        Scene::from_json(two).unwrap();
+        let out = two.replace("[15, 2, 2]", "[15, 11, 2]");
+        assert_names(
+            &message(Scene::from_json(&out)),
+            &["fluid_blocks[0] lies outside every container", "[0, 10, 0]"],
+        );
+    }
+
+    #[test]
+    fn bad_values_name_the_json_key() {
+        let cases = [
+            (
+                "\"solver\": {\"rho\": 1.5}",
+                "solver.rho must lie in [0, 1), got 1.5",
+            ),
+            (
+                "\"solver\": {\"tau\": -1}",
+                "solver.tau must be a positive finite number, got -1",
+            ),
+            (
+                "\"time\": {\"dt_max\": 0}",
+                "time.dt_max must be a positive finite number, got 0",
+            ),
+            (
+                "\"output\": {\"every\": 0}",
+                "output.every must be at least 1, got 0",
+            ),
+            ("\"viscosity\": 2", "viscosity must lie in [0, 1], got 2"),
+        ];
+        for (extra, expected) in cases {
+            let text = GOOD.replace("\"duration\": 0.5", &format!("\"duration\": 0.5, {extra}"));
+            assert_eq!(message(Scene::from_json(&text)), expected);
+        }
+        let text = GOOD.replace("\"duration\": 0.5", "\"duration\": -2");
+        assert_eq!(
+            message(Scene::from_json(&text)),
+            "duration must be a positive finite number of seconds, got -2"
+        );
+        let text = GOOD.replace("[4, 4, 4]", "[4, 0, 4]");
+        assert_names(
+            &message(Scene::from_json(&text)),
+            &["fluid_blocks[0].count", "[4, 0, 4]"],
+        );
+        let text = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, 3, 1], \"layers\": 7");
+        assert_eq!(
+            message(Scene::from_json(&text)),
+            "container[0].layers must be 1, 2 or 3, got 7"
+        );
+        let text = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, -3, 1]");
+        assert_names(&message(Scene::from_json(&text)), &["container[0]", "-3"]);
+    }
+}

@@ -1,16 +1,27 @@
 //! `projfluid run`: one scene, with progress, frames and a summary.
+//!
+//! The solver options shared with other subcommands, the progress display and the printed
+//! summary live in submodules.
 
+mod options;
+mod print;
+mod progress;
+
+pub(crate) use options::ParamOptions;
+
+use crate::Failure;
 use crate::frames::{FrameFormat, Frames};
-use crate::{Failure, RhoArg, rho_parser, solver_parser};
+use crate::solver_parser;
 use clap::Args;
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use options::validate_naming_options;
+use print::print_summary;
+use progress::Progress;
 use projfluid::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
 use projfluid::scene::Scene;
 use projfluid::{Error, SolverKind};
-use projfluid_lab::driver::{self, RunError, RunLength, StepReport};
-use projfluid_lab::summary::RunSummary;
+use projfluid_lab::driver::{self, RunError, RunLength};
 use std::fs::File;
-use std::io::{IsTerminal, Write};
+use std::io::Write;
 use std::path::PathBuf;
 
 /// Options of `projfluid run`; each given option replaces the scene's setting.
@@ -63,69 +74,6 @@ pub(crate) struct RunArgs {
     /// Write the run summary as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats: Option<PathBuf>,
-}
-
-/// Solver settings that every subcommand running scenes accepts; each given option replaces
-/// the scene's setting.
-#[derive(Args)]
-pub(crate) struct ParamOptions {
-    /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
-    #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
-    pub(crate) rho: Option<RhoArg>,
-    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
-    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
-    pub(crate) tau: Option<f64>,
-    /// Worker threads (0 = one per core).
-    #[arg(long, value_name = "N")]
-    pub(crate) threads: Option<usize>,
-}
-
-impl ParamOptions {
-    /// Sets the given options in `scene.params`.
-    fn apply(&self, scene: &mut Scene) {
-        let p = &mut scene.params;
-        if let Some(rho) = self.rho {
-            rho.apply(&mut p.chebyshev);
-        }
-        if let Some(tau) = self.tau {
-            p.displacement_tolerance = tau;
-        }
-        if let Some(threads) = self.threads {
-            p.threads = threads;
-        }
-    }
-
-    /// Which scene key each option sets, and whether it was given.
-    fn keys(&self) -> [(&'static str, &'static str, bool); 3] {
-        [
-            ("solver.rho", "--rho", self.rho.is_some()),
-            ("solver.tau", "--tau", self.tau.is_some()),
-            ("threads", "--threads", self.threads.is_some()),
-        ]
-    }
-
-    /// Applies the options to `scene` and validates it; an error caused by an option names
-    /// the option instead of the scene key.
-    pub(crate) fn apply_checked(&self, scene: &mut Scene) -> Result<(), Failure> {
-        self.apply(scene);
-        validate_naming_options(scene, &self.keys())
-    }
-}
-
-/// Validates `scene`; when the error is about a scene key set by a given option (key, option,
-/// given), the message names the option.
-fn validate_naming_options(scene: &Scene, options: &[(&str, &str, bool)]) -> Result<(), Failure> {
-    scene.validate().map_err(|e| {
-        let msg = e.to_string();
-        if let Error::InvalidArgument { field, .. } = &e {
-            for &(key, option, given) in options {
-                if given && field == key {
-                    return Failure::Input(msg.replacen(key, option, 1));
-                }
-            }
-        }
-        Failure::Input(msg)
-    })
 }
 
 /// `projfluid run`.
@@ -308,122 +256,4 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
         Some(n) => RunLength::Steps(n),
         None => RunLength::Duration(scene.duration),
     })
-}
-
-/// Progress on stderr: a bar on a terminal, else a line about every 10 % of the run.
-struct Progress {
-    bar: Option<ProgressBar>,
-    next_tenth: u32,
-    steps: u64,
-    wall: f64,
-    outer: u64,
-}
-
-impl Progress {
-    fn new(target: RunLength) -> Self {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
-            let style = ProgressStyle::with_template(
-                "{bar:20.cyan/blue} {percent:>3}% {elapsed:>4} {wide_msg}",
-            )
-            .unwrap_or_else(|_| ProgressStyle::default_bar());
-            bar.set_style(style);
-            if let RunLength::Steps(n) = target {
-                bar.set_message(format!("0/{n} steps"));
-            }
-            bar
-        });
-        Self {
-            bar,
-            next_tenth: 1,
-            steps: 0,
-            wall: 0.0,
-            outer: 0,
-        }
-    }
-
-    /// Records a finished step.
-    fn update(&mut self, report: &StepReport<'_>) {
-        self.steps += 1;
-        self.wall += report.wall_seconds;
-        self.outer += report.stats.outer_iterations as u64;
-        let n = self.steps as f64;
-        let (t, ms, outer) = (
-            report.world.time(),
-            self.wall * 1e3 / n,
-            self.outer as f64 / n,
-        );
-        let done = report.done;
-        match &self.bar {
-            Some(bar) => {
-                bar.set_position((done * 1000.0).round() as u64);
-                bar.set_message(format!(
-                    "t={t:.3}s step {} {ms:.1} ms/step {outer:.1} outer it.",
-                    self.steps
-                ));
-            }
-            None if done * 10.0 >= f64::from(self.next_tenth) - 1e-9 => {
-                eprintln!(
-                    "{:>3.0}%  t = {t:.4} s, step {}, {ms:.1} ms/step, {outer:.1} outer iterations/step",
-                    done * 100.0,
-                    self.steps
-                );
-                while f64::from(self.next_tenth) <= done * 10.0 + 1e-9 {
-                    self.next_tenth += 1;
-                }
-            }
-            None => {}
-        }
-    }
-
-    fn finish(&self) {
-        if let Some(bar) = &self.bar {
-            bar.finish();
-        }
-    }
-}
-
-/// The human-readable summary on stdout.
-fn print_summary(s: &RunSummary) -> std::io::Result<()> {
-    let rows = [
-        ("scene", s.scene.clone()),
-        (
-            "solver",
-            if s.rho_auto {
-                format!(
-                    "{} (rho auto, mean {:.3}; tau {:.3e} m)",
-                    s.solver, s.rho, s.tau
-                )
-            } else {
-                format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau)
-            },
-        ),
-        ("threads", s.threads.to_string()),
-        ("particles", s.particles.to_string()),
-        ("boundary particles", s.boundary_particles.to_string()),
-        ("steps", s.steps.to_string()),
-        ("simulated time", format!("{:.4} s", s.sim_time)),
-        (
-            "mean time per step",
-            format!("{:.2} ms", s.wall_ms_per_step),
-        ),
-        (
-            "mean outer iterations",
-            format!("{:.2}", s.outer_iterations_mean),
-        ),
-        (
-            "density error",
-            format!(
-                "avg {:.3} %, max {:.3} % (compression only)",
-                s.density_error_avg_percent, s.density_error_max_percent
-            ),
-        ),
-        ("escaped particles", s.escaped.to_string()),
-        ("NaN particles", s.nan.to_string()),
-    ];
-    let mut out = std::io::stdout().lock();
-    for (key, value) in rows {
-        writeln!(out, "{key:<22} {value}")?;
-    }
-    out.flush()
 }

@@ -1,0 +1,73 @@
+//! Solver options every subcommand that runs scenes accepts, and validation that names the
+//! option behind a bad value.
+
+use crate::{Failure, RhoArg, rho_parser};
+use clap::Args;
+use projfluid::Error;
+use projfluid::scene::Scene;
+
+/// Solver settings that every subcommand running scenes accepts; each given option replaces
+/// the scene's setting.
+#[derive(Args)]
+pub(crate) struct ParamOptions {
+    /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
+    #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
+    pub(crate) rho: Option<RhoArg>,
+    /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    pub(crate) tau: Option<f64>,
+    /// Worker threads (0 = one per core).
+    #[arg(long, value_name = "N")]
+    pub(crate) threads: Option<usize>,
+}
+
+impl ParamOptions {
+    /// Sets the given options in `scene.params`.
+    pub(super) fn apply(&self, scene: &mut Scene) {
+        let p = &mut scene.params;
+        if let Some(rho) = self.rho {
+            rho.apply(&mut p.chebyshev);
+        }
+        if let Some(tau) = self.tau {
+            p.displacement_tolerance = tau;
+        }
+        if let Some(threads) = self.threads {
+            p.threads = threads;
+        }
+    }
+
+    /// Which scene key each option sets, and whether it was given.
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 3] {
+        [
+            ("solver.rho", "--rho", self.rho.is_some()),
+            ("solver.tau", "--tau", self.tau.is_some()),
+            ("threads", "--threads", self.threads.is_some()),
+        ]
+    }
+
+    /// Applies the options to `scene` and validates it; an error caused by an option names
+    /// the option instead of the scene key.
+    pub(crate) fn apply_checked(&self, scene: &mut Scene) -> Result<(), Failure> {
+        self.apply(scene);
+        validate_naming_options(scene, &self.keys())
+    }
+}
+
+/// Validates `scene`; when the error is about a scene key set by a given option (key, option,
+/// given), the message names the option.
+pub(super) fn validate_naming_options(
+    scene: &Scene,
+    options: &[(&str, &str, bool)],
+) -> Result<(), Failure> {
+    scene.validate().map_err(|e| {
+        let msg = e.to_string();
+        if let Error::InvalidArgument { field, .. } = &e {
+            for &(key, option, given) in options {
+                if given && field == key {
+                    return Failure::Input(msg.replacen(key, option, 1));
+                }
+            }
+        }
+        Failure::Input(msg)
+    })
+}

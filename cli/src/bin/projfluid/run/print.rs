@@ -1,0 +1,49 @@
+//! The run summary as printed on stdout.
+
+use projfluid_lab::summary::RunSummary;
+use std::io::Write;
+
+/// The human-readable summary on stdout.
+pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
+    let rows = [
+        ("scene", s.scene.clone()),
+        (
+            "solver",
+            if s.rho_auto {
+                format!(
+                    "{} (rho auto, mean {:.3}; tau {:.3e} m)",
+                    s.solver, s.rho, s.tau
+                )
+            } else {
+                format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau)
+            },
+        ),
+        ("threads", s.threads.to_string()),
+        ("particles", s.particles.to_string()),
+        ("boundary particles", s.boundary_particles.to_string()),
+        ("steps", s.steps.to_string()),
+        ("simulated time", format!("{:.4} s", s.sim_time)),
+        (
+            "mean time per step",
+            format!("{:.2} ms", s.wall_ms_per_step),
+        ),
+        (
+            "mean outer iterations",
+            format!("{:.2}", s.outer_iterations_mean),
+        ),
+        (
+            "density error",
+            format!(
+                "avg {:.3} %, max {:.3} % (compression only)",
+                s.density_error_avg_percent, s.density_error_max_percent
+            ),
+        ),
+        ("escaped particles", s.escaped.to_string()),
+        ("NaN particles", s.nan.to_string()),
+    ];
+    let mut out = std::io::stdout().lock();
+    for (key, value) in rows {
+        writeln!(out, "{key:<22} {value}")?;
+    }
+    out.flush()
+}

@@ -1,0 +1,211 @@
+//! Tests of the JSON form: keys and defaults, round trips, and the messages of bad files.
+
+use crate::params::Params;
+use crate::scene::test_support::{GOOD, assert_names, message};
+use crate::scene::{OutputSpec, Scene};
+use std::path::{Path, PathBuf};
+
+#[test]
+fn defaults_come_from_params_with_radius() {
+    let scene = Scene::from_json(GOOD).unwrap();
+    assert_eq!(scene.params, Params::with_radius(0.05));
+    assert_eq!(scene.containers[0].layers, 1);
+    assert_eq!(scene.fluid_blocks[0].velocity, [0.0; 3]);
+    assert_eq!(scene.output, OutputSpec::default());
+    assert_eq!(scene.particle_count(), 64 + 12);
+}
+
+/// A weighting's name is the value scenes write for it, and it parses back; an unknown
+/// name does not.
+#[test]
+fn projection_weight_names_are_the_scene_values() {
+    use crate::ProjectionWeight as W;
+    for w in [W::NeighborCount, W::Unit, W::Uniform] {
+        let text = format!(
+            r#"{{"particle_radius": 0.025, "container": {{"min": [0, 0, 0], "max": [1, 1, 1]}},
+                    "fluid_blocks": [{{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2]}}],
+                    "duration": 1, "solver": {{"projection_weight": "{}"}}}}"#,
+            w.name()
+        );
+        let scene = Scene::from_json(&text).unwrap();
+        assert_eq!(scene.params.projection_weight, w);
+        assert_eq!(W::from_name(w.name()), Some(w));
+    }
+    assert_eq!(W::from_name("neighbour_count"), None);
+}
+
+#[test]
+fn every_key_is_read() {
+    let text = r#"{
+            "name": "all", "description": "every key",
+            "particle_radius": 0.02, "rest_density": 998, "mass_factor": 0.9, "stiffness": 1e5,
+            "gravity": [0, 0, -9.8],
+            "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "layers": 2}],
+            "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2], "velocity": [0, 1, 0]}],
+            "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "paper", "gamma": 0.9,
+                       "tau": 1e-6, "max_iterations": 50, "min_iterations": 2,
+                       "projection_weight": "unit"},
+            "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
+            "viscosity": 0.02, "threads": 2, "duration": 3,
+            "output": {"dir": "frames", "every": 5}
+        }"#;
+    let s = Scene::from_json(text).unwrap();
+    let p = &s.params;
+    assert_eq!(
+        (
+            p.particle_radius,
+            p.rest_density,
+            p.mass_factor,
+            p.stiffness
+        ),
+        (0.02, 998.0, 0.9, 1e5)
+    );
+    assert_eq!(p.gravity, [0.0, 0.0, -9.8]);
+    assert_eq!(p.solver, crate::SolverKind::Jacobi);
+    assert_eq!(p.chebyshev.rho, 0.8);
+    assert_eq!(p.chebyshev.delay, 2);
+    assert_eq!(p.chebyshev.omega2_rule, crate::Omega2Rule::Paper);
+    assert_eq!(p.chebyshev.gamma, 0.9);
+    assert_eq!(p.displacement_tolerance, 1e-6);
+    assert_eq!((p.min_outer_iterations, p.max_outer_iterations), (2, 50));
+    assert_eq!(p.projection_weight, crate::ProjectionWeight::Unit);
+    assert_eq!(
+        (p.cfl_factor, p.dt_min, p.dt_max, p.dt_initial),
+        (0.4, 1e-5, 1e-2, 2e-3)
+    );
+    assert_eq!((p.viscosity, p.threads), (0.02, 2));
+    assert_eq!(s.containers[0].layers, 2);
+    assert_eq!(s.fluid_blocks[0].velocity, [0.0, 1.0, 0.0]);
+    assert_eq!(s.duration, 3.0);
+    assert_eq!(s.description, "every key");
+    assert_eq!(s.output.dir.as_deref(), Some(Path::new("frames")));
+    assert_eq!(s.output.every, 5);
+}
+
+#[test]
+fn round_trip_through_json() {
+    let mut scenes: Vec<Scene> = Scene::builtin_names()
+        .iter()
+        .map(|n| Scene::builtin(n).unwrap())
+        .collect();
+    let mut custom = Scene::from_json(GOOD).unwrap();
+    custom.params.displacement_tolerance = 1.0 / 3.0 * 1e-4;
+    custom.params.solver = crate::SolverKind::Jacobi1;
+    custom.params.projection_weight = crate::ProjectionWeight::Unit;
+    custom.params.chebyshev.omega2_rule = crate::Omega2Rule::Paper;
+    custom.output.dir = Some(PathBuf::from("out [1]/frames"));
+    custom.description = "quotes \" and [brackets]".to_string();
+    scenes.push(custom);
+    for scene in scenes {
+        let json = scene.to_json();
+        assert_eq!(Scene::from_json(&json).unwrap(), scene, "{json}");
+    }
+}
+
+#[test]
+fn to_json_keeps_number_arrays_on_one_line() {
+    let json = Scene::builtin("dam_break_small").unwrap().to_json();
+    assert!(json.contains("\"count\": [16, 20, 12]"), "{json}");
+}
+
+#[test]
+fn missing_required_fields_are_named() {
+    let text = GOOD.replace("\"duration\": 0.5", "\"threads\": 1");
+    assert_names(
+        &message(Scene::from_json(&text)),
+        &["missing field `duration`"],
+    );
+    let text = GOOD.replace("\"particle_radius\": 0.05,", "");
+    assert_names(&message(Scene::from_json(&text)), &["`particle_radius`"]);
+    let text = r#"{"particle_radius": 0.05, "duration": 1}"#;
+    assert_names(&message(Scene::from_json(text)), &["`fluid_blocks`"]);
+}
+
+#[test]
+fn unknown_keys_are_errors_with_their_path() {
+    let text = GOOD.replace("\"duration\": 0.5", "\"duration\": 0.5, \"foo\": 1");
+    let msg = message(Scene::from_json(&text));
+    assert_names(&msg, &["unknown field `foo`", "line 9"]);
+    let text = GOOD.replace("\"count\": [4, 4, 4]", "\"count\": [4, 4, 4], \"speed\": 2");
+    assert_names(
+        &message(Scene::from_json(&text)),
+        &["fluid_blocks[0]", "unknown field `speed`"],
+    );
+    let text = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, 3, 1], \"layer\": 2");
+    assert_names(
+        &message(Scene::from_json(&text)),
+        &["container", "unknown field `layer`"],
+    );
+}
+
+#[test]
+fn wrong_types_and_names_say_where() {
+    let text = GOOD.replace(
+        "\"duration\": 0.5",
+        "\"duration\": 0.5, \"solver\": {\"kind\": \"sor\"}",
+    );
+    assert_names(
+        &message(Scene::from_json(&text)),
+        &["solver.kind", "`sor`", "chebyshev"],
+    );
+    let text = GOOD.replace("[4, 4, 4]", "[4, -4, 4]");
+    assert_names(
+        &message(Scene::from_json(&text)),
+        &["fluid_blocks[0].count[1]", "-4"],
+    );
+}
+
+#[test]
+fn rho_auto_is_read_written_and_checked() {
+    let auto = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"solver\": {\"rho\": \"auto\"}, \"fluid_blocks\"",
+        1,
+    );
+    let scene = Scene::from_json(&auto).unwrap();
+    assert!(scene.params.chebyshev.auto_rho);
+    let again = Scene::from_json(&scene.to_json()).unwrap();
+    assert_eq!(again.params, scene.params);
+    // The online estimate is the default, and a number always gives a fixed ρ_c.
+    assert!(Scene::from_json(GOOD).unwrap().params.chebyshev.auto_rho);
+    let fixed = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"solver\": {\"rho\": 0.9}, \"fluid_blocks\"",
+        1,
+    );
+    let fixed = Scene::from_json(&fixed).unwrap().params.chebyshev;
+    assert!(!fixed.auto_rho && fixed.rho == 0.9);
+    let bad = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"solver\": {\"rho\": \"fast\"}, \"fluid_blocks\"",
+        1,
+    );
+    assert_names(
+        &message(Scene::from_json(&bad)),
+        &["solver.rho", "fast", "\"auto\""],
+    );
+}
+
+#[test]
+fn documented_example_is_valid() {
+    let doc = include_str!("../../../docs/scene-format.md");
+    let example = doc
+        .split("```json\n")
+        .nth(1)
+        .and_then(|rest| rest.split("```").next())
+        .expect("docs/scene-format.md has a json scene example");
+    let scene = Scene::from_json(example).unwrap();
+    let mut expected = Scene::builtin("dam_break_small").unwrap();
+    expected.description = scene.description.clone();
+    expected.output = OutputSpec {
+        dir: Some(PathBuf::from("frames")),
+        every: 20,
+    };
+    assert_eq!(scene, expected);
+}
+
+#[test]
+fn trailing_garbage_is_an_error() {
+    let msg = message(Scene::from_json(&format!("{GOOD} x")));
+    assert_names(&msg, &["line 10", "trailing"]);
+}

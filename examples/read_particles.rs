@@ -38,7 +38,10 @@ fn main() -> Result<(), projfluid::Error> {
     world
         .write_positions_f32(&mut buffer)
         .expect("the buffer holds 3 floats per particle");
-    println!("first particle at ({:.3}, {:.3}, {:.3}) m", buffer[0], buffer[1], buffer[2]);
+    println!(
+        "first particle at ({:.3}, {:.3}, {:.3}) m",
+        buffer[0], buffer[1], buffer[2]
+    );
 
     if let Some(path) = std::env::args().nth(1) {
         projfluid::io::vtk::write_vtk(

@@ -6,7 +6,9 @@ use crate::Vec3;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use crate::params::Params;
-use crate::xsph::Xsph;
+use xsph::Xsph;
+
+mod xsph;
 
 /// A force other than pressure, applied to the fluid's velocities at the end of a step.
 pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {

@@ -34,7 +34,6 @@ pub mod solver;
 pub mod stats;
 mod step;
 mod world;
-mod xsph;
 
 pub use error::Error;
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};

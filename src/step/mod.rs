@@ -3,7 +3,7 @@
 //! neighbours on s; [`iterate`] alternates local projections and global solves (with
 //! Chebyshev's extrapolation) until the displacement rule stops; [`finish`] updates the
 //! velocities, evaluates densities, applies the non-pressure forces and measures the step;
-//! [`next_step_size`] chooses the next Δt by the CFL rule (§8).
+//! [`next_step_size`] chooses the next Δt by the CFL rule (docs/method.md §8).
 
 mod finish;
 mod iterate;

@@ -1,10 +1,10 @@
 //! XSPH viscosity (docs/method.md §1.3): v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij, a filter
 //! that blends each velocity with its neighbours'.
 
+use super::NonPressureForce;
 use crate::Vec3;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
-use crate::forces::NonPressureForce;
 use rayon::prelude::*;
 
 /// The XSPH filter with coefficient c (dimensionless), with its buffer of volumes.

@@ -306,8 +306,8 @@ impl SampleGrid {
     }
 }
 
-/// Checks of a sampling's spacing and coverage, shared by the tests here and elsewhere.
-
+/// Checks of a sampling's spacing and coverage, shared by the tests here and elsewhere, and
+/// the sampler's tests.
 #[cfg(test)]
 #[path = "poisson_disk_tests.rs"]
 mod test_checks;

@@ -19,7 +19,7 @@ STRIP ?= strip
 all: build
 
 build:
-	$(CARGO) build --release --lib
+	$(CARGO) build --release --lib --package projfluid
 
 install: build install-files
 

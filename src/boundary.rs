@@ -15,6 +15,10 @@ pub mod winding;
 pub(crate) use particles::Boundary;
 pub use transform::Transform;
 
+/// The owner index of boundary particles that belong to walls and static obstacles rather
+/// than to a body.
+pub(crate) const WALLS: u32 = u32::MAX;
+
 /// An axis-aligned box, corners in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
@@ -127,6 +131,26 @@ fn volumes_in_batches(
         }));
     }
     volumes
+}
+
+/// Akinci masses ψ = ρ0·V (kg) of `points` (m) computed over these points alone, in their
+/// order: the masses of a body's particles in its own frame.
+pub(crate) fn own_masses(points: &[Vec3], kernel: &CubicKernel, rest_density: f64) -> Vec<f64> {
+    let Some(bounds) = Aabb::around(points) else {
+        return Vec::new();
+    };
+    let grid = UniformGrid::covering(bounds.min, bounds.max, kernel.support_radius());
+    let (mut order, mut table) = (Vec::new(), CellTable::default());
+    grid.sort(points, &mut order, &mut table);
+    let sorted: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
+    let mut by_component = PointsByComponent::default();
+    by_component.fill(&sorted);
+    let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, kernel);
+    let mut psi = vec![0.0; points.len()];
+    for (&i, v) in order.iter().zip(volumes) {
+        psi[i as usize] = v * rest_density;
+    }
+    psi
 }
 
 #[cfg(test)]

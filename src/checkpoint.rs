@@ -6,11 +6,13 @@
 //!
 //! Layout: the magic `PFCHECK1`; the length (u64, little-endian) of a JSON header, the
 //! header (the scene with the world's parameters, time, step count, next Δt, containers,
-//! grid, counts, the run's end, the online ρ_c estimate); the fluid positions, velocities and densities as f64
-//! triples/values, the particle ids as u32, the boundary positions as f64 triples (all
-//! little-endian); and a SHA-256 digest of everything before it, so that a damaged or
+//! grid, counts, the run's end, the online ρ_c estimate, the bodies' poses, velocities and
+//! loads); the fluid positions, velocities and densities as f64
+//! triples/values, the particle ids as u32, the static boundary positions as f64 triples and
+//! their owners as u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged or
 //! truncated file is refused.
 
+use crate::body::{BodyState, Pose, Velocity};
 use crate::boundary::Aabb;
 use crate::scene::Scene;
 use crate::solver::OnlineRho;
@@ -19,7 +21,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK1";
+const MAGIC: &[u8; 8] = b"PFCHECK2";
+/// The magic of the format before bodies, named in the error that refuses it.
+const MAGIC_V1: &[u8; 8] = b"PFCHECK1";
 const DIGEST_LEN: usize = 32;
 
 /// Where the interrupted run was going to stop.
@@ -59,6 +63,55 @@ struct Header {
     boundary_count: usize,
     run_end: Option<RunEnd>,
     chebyshev: OnlineRho,
+    bodies: Vec<SavedBody>,
+}
+
+/// A body's changing state in the header, every number exact (serde_json round-trips f64).
+#[derive(Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SavedBody {
+    /// Position (m) and quaternion [w, x, y, z].
+    pose: ([f64; 3], [f64; 4]),
+    /// Linear (m/s) and angular (rad/s) velocity.
+    velocity: [[f64; 3]; 2],
+    target: Option<([f64; 3], [f64; 4])>,
+    /// Force (N) and torque (N·m).
+    load: [[f64; 3]; 2],
+}
+
+impl SavedBody {
+    fn of(b: &BodyState) -> Self {
+        let pose = |p: &Pose| (p.position.into(), p.wxyz());
+        Self {
+            pose: pose(&b.pose),
+            velocity: [b.velocity.linear.into(), b.velocity.angular.into()],
+            target: b.target.as_ref().map(pose),
+            load: [b.force.into(), b.torque.into()],
+        }
+    }
+
+    /// The state, or an error naming what is not a valid pose.
+    fn state(&self) -> Result<BodyState, Error> {
+        let pose = |(x, q): &([f64; 3], [f64; 4])| {
+            // Stored quaternions are unit to round-off; keep them exactly as saved.
+            Pose::from_parts(Vec3::from(*x), *q).map(|_| Pose {
+                position: Vec3::from(*x),
+                rotation: crate::body::Rotation::new_unchecked(nalgebra::Quaternion::new(
+                    q[0], q[1], q[2], q[3],
+                )),
+            })
+        };
+        Ok(BodyState {
+            pose: pose(&self.pose)?,
+            velocity: Velocity {
+                linear: Vec3::from(self.velocity[0]),
+                angular: Vec3::from(self.velocity[1]),
+            },
+            target: self.target.as_ref().map(pose).transpose()?,
+            force: Vec3::from(self.load[0]),
+            torque: Vec3::from(self.load[1]),
+        })
+    }
 }
 
 /// Writes a checkpoint of `world`, which was built from `scene`, to `path` (through a
@@ -90,12 +143,13 @@ pub fn write_checkpoint(
         boundary_count: state.boundary_positions.len(),
         run_end,
         chebyshev: state.online_rho,
+        bodies: state.bodies.iter().map(SavedBody::of).collect(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
     let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 60 + f.boundary_positions.len() * 24,
+        64 + json.len() + f.positions.len() * 60 + f.boundary_positions.len() * 28,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
@@ -111,6 +165,9 @@ pub fn write_checkpoint(
     }
     for p in &f.boundary_positions {
         push_vec3(&mut bytes, p);
+    }
+    for o in &f.boundary_owners {
+        bytes.extend_from_slice(&o.to_le_bytes());
     }
     let digest = Sha256::digest(&bytes);
     bytes.extend_from_slice(&digest);
@@ -141,6 +198,11 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         field: "checkpoint".to_string(),
         message: format!("{}: {what}", path.display()),
     };
+    if bytes.starts_with(MAGIC_V1) {
+        return Err(bad(
+            "is a checkpoint of an earlier version without bodies, which this version cannot resume",
+        ));
+    }
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
@@ -168,7 +230,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let (n, m) = (header.fluid_count, header.boundary_count);
     let expected = n
         .checked_mul(3 * 8 * 2 + 8 + 4)
-        .and_then(|f| m.checked_mul(24).and_then(|b| f.checked_add(b)));
+        .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
             "holds {} bytes of particle data, not the {n} fluid and {m} boundary particles its header announces",
@@ -187,6 +249,13 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
     let ids: Vec<u32> = (0..n).map(|_| u32::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
+    let owners: Vec<u32> = (0..m).map(|_| u32::from_le_bytes(data.take())).collect();
+    let bodies = header
+        .bodies
+        .iter()
+        .map(SavedBody::state)
+        .collect::<Result<Vec<_>, _>>()
+        .map_err(|e| bad(&format!("holds an invalid body pose: {e}")))?;
     let state = WorldState {
         time: header.time,
         steps: header.steps,
@@ -196,6 +265,8 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         densities,
         ids,
         boundary_positions: boundary,
+        boundary_owners: owners,
+        bodies,
         boundary_sorted: !header.boundary_dirty,
         containers: header
             .containers

@@ -14,6 +14,7 @@
 //!
 //! Units are SI throughout: metres, seconds, kilograms.
 
+pub mod body;
 pub mod boundary;
 pub mod checkpoint;
 pub mod constraint;
@@ -37,7 +38,7 @@ mod world;
 
 pub use error::Error;
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
-pub use world::{GridParts, World, WorldState};
+pub use world::{BodyId, GridParts, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).
 pub type Vec3 = nalgebra::Vector3<f64>;

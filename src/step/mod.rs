@@ -5,12 +5,15 @@
 //! velocities, evaluates densities, applies the non-pressure forces and measures the step;
 //! [`next_step_size`] chooses the next Δt by the CFL rule (docs/method.md §8).
 
+mod couple;
 mod finish;
 mod iterate;
 mod search;
 
+pub(crate) use couple::Load;
 pub(crate) use search::SearchGrid;
 
+use crate::body::Body;
 use crate::boundary::Boundary;
 use crate::constraint::{Corrections, DensityConstraint, Projection};
 use crate::fluid::Fluid;
@@ -48,6 +51,8 @@ pub(crate) struct StepBuffers {
     scratch_ids: Vec<u32>,
     /// δ_k of every outer iteration of the last step (m).
     pub(crate) displacements: Vec<f64>,
+    /// The fluid's load on each body and, last, on the walls.
+    loads: Vec<Load>,
 }
 
 /// Everything one time step reads and writes, borrowed from the world that owns it.
@@ -62,6 +67,11 @@ pub(crate) struct StepContext<'a> {
     pub chebyshev: &'a mut Chebyshev,
     pub forces: &'a mut [Box<dyn NonPressureForce>],
     pub buffers: &'a mut StepBuffers,
+    pub bodies: &'a mut [Body],
+    /// The fluid's load on the walls and static obstacles (written).
+    pub wall_load: &'a mut Load,
+    /// Simulated time at the start of the step (s).
+    pub time: f64,
 }
 
 /// Advances the fluid by one step of `dt` seconds (positive, finite, checked by the
@@ -79,12 +89,21 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         chebyshev,
         forces,
         buffers,
+        bodies,
+        wall_load,
+        time,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
+    for body in bodies.iter_mut() {
+        body.advance_pose(dt, time + dt);
+    }
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
     let stats = pool.install(|| {
+        if boundary.has_moving() {
+            boundary.place_moving(grid, moving_particles(bodies));
+        }
         search::reorder_and_search(grid, fluid, boundary, params.support_radius(), buffers);
         timings.neighbors = started.elapsed().as_secs_f64();
         let outcome = iterate::iterate(
@@ -99,6 +118,28 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
             buffers,
             &mut timings,
         );
+        if !bodies.is_empty() {
+            couple::Reaction {
+                stiffness: params.stiffness,
+                constraint,
+                boundary,
+                fluid_lists: &buffers.fluid_lists,
+                boundary_lists: &buffers.boundary_lists,
+                x: &buffers.previous,
+                projections: &buffers.projections,
+                weights: &buffers.weights,
+                predicted: buffers.fluid_lists.searched_points(),
+                positions: &buffers.current,
+                dt,
+            }
+            .loads(bodies.len(), &mut buffers.loads);
+            for (body, load) in bodies.iter_mut().zip(&buffers.loads) {
+                body.force = load.force;
+                body.torque = load.torque_about(&body.centre_of_mass());
+                body.accelerate(dt, gravity);
+            }
+            *wall_load = buffers.loads[bodies.len()];
+        }
         finish::finish(
             finish::Finish {
                 params,
@@ -113,15 +154,42 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
             &mut timings,
         )
     });
-    let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt));
+    let body_speed = bodies
+        .iter()
+        .map(|b| b.max_particle_speed())
+        .fold(0.0, f64::max);
+    let next_dt =
+        pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, body_speed));
     (stats, next_dt)
 }
 
-/// The CFL rule (docs/method.md §8): Δt = λ·0.4·2r / max|v + Δt g|, clamped to
-/// [Δt_min, Δt_max] (s).
-fn next_step_size(params: &Params, velocities: &[Vec3], gravity: Vec3, dt: f64) -> f64 {
+/// The moving bodies' particles at their poses: position (m), ψ (kg) and owner.
+fn moving_particles(bodies: &[Body]) -> impl Iterator<Item = (Vec3, f64, u32)> + '_ {
+    bodies
+        .iter()
+        .enumerate()
+        .filter(|(_, b)| b.moves())
+        .flat_map(|(o, b)| {
+            b.samples
+                .iter()
+                .zip(&b.psi)
+                .map(move |(s, &psi)| (b.pose.apply(s), psi, o as u32))
+        })
+}
+
+/// The CFL rule (docs/method.md §8, §11): Δt = λ·0.4·2r / v_max, clamped to
+/// [Δt_min, Δt_max] (s), where v_max is the larger of max|v + Δt g| over the fluid and
+/// `body_speed`, the fastest body particle (m/s), so that no body moves more than a fraction
+/// of a particle spacing per step.
+fn next_step_size(
+    params: &Params,
+    velocities: &[Vec3],
+    gravity: Vec3,
+    dt: f64,
+    body_speed: f64,
+) -> f64 {
     let v_max = reduce::max(velocities, |v| (v + gravity * dt).norm_squared());
-    let v_max = v_max.max(1e-9).sqrt();
+    let v_max = v_max.max(1e-9).sqrt().max(body_speed);
     let cfl = params.cfl_factor * 0.4 * params.spacing() / v_max;
     if cfl.is_finite() {
         cfl.clamp(params.dt_min, params.dt_max)

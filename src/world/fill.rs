@@ -4,7 +4,7 @@
 
 use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
-use crate::boundary::{Aabb, sample_box_walls};
+use crate::boundary::{Aabb, WALLS, sample_box_walls};
 use crate::{Error, Vec3};
 
 /// Most boundary particles one triangle mesh may need (by [`sample_count_bound`]), which also
@@ -91,8 +91,7 @@ impl World {
                 "would exceed the boundary particle limit",
             ));
         }
-        self.boundary.positions.extend_from_slice(positions);
-        self.boundary.dirty = true;
+        self.boundary.add_static(positions, WALLS);
         Ok(())
     }
 
@@ -156,7 +155,8 @@ impl World {
         &mut self,
         additional: usize,
     ) -> Result<(), std::collections::TryReserveError> {
-        self.boundary.positions.try_reserve(additional)
+        self.boundary.positions.try_reserve(additional)?;
+        self.boundary.owner.try_reserve(additional)
     }
 
     /// Adds a static obstacle: the surface of `mesh` (m) sampled by Poisson disk with a

@@ -4,6 +4,7 @@
 //! [`read`] reports particles and measures, [`stepping`] advances time, [`state`] exports
 //! and imports the exact state.
 
+mod bodies;
 mod fill;
 mod read;
 mod state;
@@ -11,8 +12,10 @@ mod stepping;
 #[cfg(test)]
 mod tests;
 
+pub use bodies::BodyId;
 pub use state::{GridParts, WorldState};
 
+use crate::body::Body;
 use crate::boundary::{Aabb, Boundary};
 use crate::constraint::DensityConstraint;
 use crate::fluid::Fluid;
@@ -21,7 +24,7 @@ use crate::kernel::CubicKernel;
 use crate::params::{Params, SolverKind};
 use crate::solver::{Chebyshev, GlobalSolver, linear_solver};
 use crate::stats::StepStats;
-use crate::step::{SearchGrid, StepBuffers};
+use crate::step::{Load, SearchGrid, StepBuffers};
 use crate::{Error, Vec3};
 
 /// A fluid simulation: particles, boundaries, parameters and the state of time stepping.
@@ -34,6 +37,10 @@ pub struct World {
     /// Container boxes; fluid outside all of them counts as escaped.
     pub(crate) containers: Vec<Aabb>,
     pub(crate) grid: SearchGrid,
+    /// Rigid bodies, in the order they were added.
+    pub(crate) bodies: Vec<Body>,
+    /// The fluid's load on the walls and static obstacles in the last step.
+    pub(crate) wall_load: Load,
     pub(crate) solver: Box<dyn GlobalSolver>,
     pub(crate) chebyshev: Chebyshev,
     /// Viscosity and the other non-pressure forces, in the order they apply.
@@ -79,6 +86,8 @@ impl World {
             boundary: Boundary::default(),
             containers: Vec::new(),
             grid: SearchGrid::default(),
+            bodies: Vec::new(),
+            wall_load: Load::default(),
             solver: linear_solver(params.solver),
             chebyshev: Chebyshev::new(params.chebyshev),
             forces: forces::from_params(&params),

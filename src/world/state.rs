@@ -8,7 +8,8 @@
 //! part of the state, as they are.
 
 use super::World;
-use crate::boundary::Aabb;
+use crate::body::BodyState;
+use crate::boundary::{Aabb, WALLS};
 use crate::neighbors::UniformGrid;
 use crate::solver::OnlineRho;
 use crate::step::SearchGrid;
@@ -33,8 +34,14 @@ pub struct WorldState {
     pub densities: Vec<f64>,
     /// The index each stored fluid particle was added with: a permutation of 0..n.
     pub ids: Vec<u32>,
-    /// Boundary particle positions (m).
+    /// Static boundary particle positions (m): walls, obstacles and static bodies (moving
+    /// bodies' particles follow from their poses).
     pub boundary_positions: Vec<Vec3>,
+    /// The body each static boundary particle belongs to (its [`crate::BodyId`]), or
+    /// `u32::MAX` for walls and obstacles.
+    pub boundary_owners: Vec<u32>,
+    /// The state of every body, in the order they were added.
+    pub bodies: Vec<BodyState>,
     /// The boundary is sorted into `grid`'s cells (else it is sorted before the next step).
     pub boundary_sorted: bool,
     /// Container boxes (m).
@@ -63,6 +70,7 @@ impl World {
     /// The world's exact state (a copy).
     pub fn export_state(&self) -> WorldState {
         let fluid = &self.fluid;
+        let (boundary_positions, boundary_owners) = self.boundary.statics();
         WorldState {
             time: self.time,
             steps: self.steps,
@@ -71,7 +79,9 @@ impl World {
             velocities: fluid.velocities.clone(),
             densities: fluid.densities.clone(),
             ids: fluid.ids.clone(),
-            boundary_positions: self.boundary.positions.clone(),
+            boundary_positions,
+            boundary_owners,
+            bodies: self.bodies.iter().map(|b| b.state()).collect(),
             boundary_sorted: !self.boundary.dirty,
             containers: self.containers.clone(),
             grid: self.grid.grid.as_ref().map(|g| {
@@ -122,6 +132,47 @@ impl World {
                 }
             }
         }
+        if state.boundary_owners.len() != state.boundary_positions.len() {
+            return Err(Error::invalid(
+                "state.boundary_owners",
+                state.boundary_owners.len(),
+                &format!(
+                    "must have one entry per boundary position ({})",
+                    state.boundary_positions.len()
+                ),
+            ));
+        }
+        let static_body = |o: u32| self.bodies.get(o as usize).is_some_and(|b| !b.moves());
+        if let Some(o) = state
+            .boundary_owners
+            .iter()
+            .find(|&&o| o != WALLS && !static_body(o))
+        {
+            return Err(Error::invalid(
+                "state.boundary_owners",
+                o,
+                "must name a static body of this world or the walls",
+            ));
+        }
+        if state.bodies.len() != self.bodies.len() {
+            return Err(Error::invalid(
+                "state.bodies",
+                state.bodies.len(),
+                &format!(
+                    "must hold one state per body of the world ({})",
+                    self.bodies.len()
+                ),
+            ));
+        }
+        for (k, b) in state.bodies.iter().enumerate() {
+            let poses = std::iter::once(&b.pose).chain(&b.target);
+            for pose in poses {
+                crate::body::Pose::from_parts(pose.position, pose.wxyz())
+                    .map_err(|e| prefixed_state(e, k))?;
+            }
+            b.velocity.validate().map_err(|e| prefixed_state(e, k))?;
+            super::check_finite("state.bodies.load", &[b.force, b.torque])?;
+        }
         if n > super::MAX_PARTICLES || state.boundary_positions.len() > super::MAX_PARTICLES {
             return Err(Error::invalid("state", n, "exceeds the particle limit"));
         }
@@ -140,6 +191,11 @@ impl World {
         fluid.densities = state.densities;
         fluid.ids = state.ids;
         self.boundary.positions = state.boundary_positions;
+        self.boundary.owner = state.boundary_owners;
+        self.boundary.psi.clear();
+        for (body, b) in self.bodies.iter_mut().zip(&state.bodies) {
+            body.set_state(b);
+        }
         self.containers = state.containers;
         self.time = state.time;
         self.steps = state.steps;
@@ -159,5 +215,16 @@ impl World {
         }
         self.last = None;
         Ok(())
+    }
+}
+
+/// Names body `k` of a state in an error.
+fn prefixed_state(e: Error, k: usize) -> Error {
+    match e {
+        Error::InvalidArgument { field, message } => Error::InvalidArgument {
+            field: format!("state.bodies[{k}].{field}"),
+            message,
+        },
+        other => other,
     }
 }

@@ -40,6 +40,9 @@ impl World {
             chebyshev,
             forces,
             buffers,
+            bodies,
+            wall_load,
+            time,
             ..
         } = self;
         let context = StepContext {
@@ -53,6 +56,9 @@ impl World {
             chebyshev,
             forces,
             buffers,
+            bodies,
+            wall_load,
+            time: *time,
         };
         let (stats, next_dt) = take_step(context, dt);
         self.next_dt = next_dt;

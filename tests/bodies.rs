@@ -274,3 +274,24 @@ fn bad_bodies_and_moves_are_rejected_and_change_nothing() {
     );
     assert_eq!(fingerprint(&world).1, poses);
 }
+
+#[test]
+fn boundary_particles_show_moving_bodies_where_they_are() {
+    let (mut world, paddle) = paddle_channel(1);
+    let body_particles = world.body(paddle).unwrap().particle_count();
+    let walls = world.boundary_positions().len();
+    let before = world.boundary_particles();
+    assert_eq!(before.len(), walls + body_particles);
+    let xs = |points: &[Vec3]| {
+        points
+            .iter()
+            .filter(|p| p.x < 1.15 && p.y > 0.05 && p.y < 0.75 && p.z > 0.05 && p.z < 0.35)
+            .map(|p| p.x)
+            .fold(0.0, f64::max)
+    };
+    assert!((xs(&before) - 0.31).abs() < 0.02, "{}", xs(&before));
+    world.advance(0.05).unwrap();
+    let after = world.boundary_particles();
+    assert_eq!(after.len(), walls + body_particles);
+    assert!((xs(&after) - 0.41).abs() < 0.02, "{}", xs(&after));
+}

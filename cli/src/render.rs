@@ -73,8 +73,8 @@ impl Renderer {
         }
     }
 
-    /// Draws the world's fluid, its obstacle particles (boundary particles farther than r/2
-    /// from every container wall) and its containers.
+    /// Draws the world's fluid, its obstacle and body particles (boundary particles farther
+    /// than r/2 from every container wall) and its containers.
     pub fn render_world(&self, world: &World) -> Image {
         let r = world.params().particle_radius;
         let containers = world.containers();
@@ -87,10 +87,9 @@ impl Renderer {
             })
         };
         let obstacle: Vec<Vec3> = world
-            .boundary_positions()
-            .iter()
+            .boundary_particles()
+            .into_iter()
             .filter(|p| !on_wall(p))
-            .copied()
             .collect();
         self.render(&Frame {
             positions: &world.positions(),

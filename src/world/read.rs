@@ -55,9 +55,20 @@ impl World {
         out
     }
 
-    /// Static boundary particle positions (m), in the world's storage order.
+    /// Boundary particle positions (m), in the world's storage order: walls, obstacles and
+    /// static bodies, and the moving bodies' particles where the last step placed them.
     pub fn boundary_positions(&self) -> &[Vec3] {
         &self.boundary.positions
+    }
+
+    /// Every boundary particle where it is now (m): the static ones, then each moving body's
+    /// at its current pose (also before the first step and after an import).
+    pub fn boundary_particles(&self) -> Vec<Vec3> {
+        let (mut points, _) = self.boundary.statics();
+        for body in self.bodies.iter().filter(|b| b.moves()) {
+            points.extend(body.particle_positions());
+        }
+        points
     }
 
     /// Kinetic energy Σ ½m|v|² (J).

@@ -25,6 +25,7 @@ fn main() -> Result<(), projfluid::Error> {
             layers: 1,
         }],
         obstacles: Vec::new(),
+        bodies: Vec::new(),
         fluid_blocks: vec![
             FluidBlock {
                 start: [0.05, 0.05, 0.05],

@@ -5,9 +5,9 @@
  * Regenerate with: PROJFLUID_BLESS=1 cargo test --test header
  *
  * Conventions: functions that can fail return a PfStatus; on failure nothing was changed
- * and pf_last_error_message() explains why. Units are SI (m, s, kg). Vectors are flat
- * x, y, z float arrays. One world must not be used from two threads at once; distinct
- * worlds may be used in parallel.
+ * and pf_last_error_message() explains why. Units are SI (m, s, kg). Particle vectors are
+ * flat x, y, z float arrays; rigid bodies' vectors and poses are doubles. One world must not
+ * be used from two threads at once; distinct worlds may be used in parallel.
  */
 
 #ifndef PROJFLUID_H
@@ -132,6 +132,26 @@ typedef enum PfProjectionWeight {
      */
     PF_WEIGHT_UNIFORM = 2,
 } PfProjectionWeight;
+
+/**
+ * How a body moves. Functions take it as an `int` holding one of these values, so that any
+ * value a caller passes is checked instead of being undefined behaviour.
+ */
+typedef enum PfBodyKind {
+    /**
+     * Never moves; its particles join the walls'. Its pose and velocity cannot be set.
+     */
+    PF_BODY_STATIC = 0,
+    /**
+     * Moves as the program says (`pf_body_set_pose`, `pf_body_set_velocity`,
+     * `pf_body_set_target_pose`); the fluid does not move it.
+     */
+    PF_BODY_KINEMATIC = 1,
+    /**
+     * Moved by gravity and the fluid's force and torque; needs a density.
+     */
+    PF_BODY_DYNAMIC = 2,
+} PfBodyKind;
 
 /**
  * An opaque simulation world: fluid particles, boundary particles, parameters and its own
@@ -310,6 +330,24 @@ typedef struct PfStepStats {
      */
     size_t nan_count;
 } PfStepStats;
+
+/**
+ * Where a body's frame is: the position of its origin in world coordinates (m) and its
+ * orientation as a unit quaternion `w, x, y, z` (body frame → world). A body's shape or
+ * mesh is given in its own frame, so the pose places it. The identity is position 0 and
+ * rotation (1, 0, 0, 0) (`pf_pose_identity`). Inputs must be finite, with |q| within 1e-6
+ * of 1 (the library normalises it). Plain data owned by the caller; the library copies it.
+ */
+typedef struct PfPose {
+    /**
+     * The body frame's origin (m).
+     */
+    double position[3];
+    /**
+     * The orientation as a unit quaternion: w, x, y, z.
+     */
+    double rotation[4];
+} PfPose;
 
 #ifdef __cplusplus
 extern "C" {
@@ -678,6 +716,257 @@ enum PfStatus pf_world_positions_hash(const struct PfWorld *world,
                                       char *out,
                                       size_t capacity,
                                       size_t *needed);
+
+/**
+ * Writes the identity pose (origin 0, rotation w = 1, x = y = z = 0) to `*out`.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`. Thread safety: may be called from any thread.
+ *
+ * # Safety
+ * `out` must be NULL or point to a writable `PfPose`.
+ */
+enum PfStatus pf_pose_identity(struct PfPose *out);
+
+/**
+ * Adds a box-shaped rigid body of `kind` (a `PfBodyKind`) with half-extents
+ * `half_extents[0..3]` (m, along the body's x, y and z axes) centred on its frame's origin,
+ * placed by `*pose`, and stores its id in `*out_id`. Its surface is sampled with boundary
+ * particles about r apart (Poisson disk, as `pf_world_add_mesh`), reproducibly.
+ *
+ * `density` (kg/m³) fills the box: it is required (> 0) for `PF_BODY_DYNAMIC` bodies,
+ * whose mass and inertia it gives; for static and kinematic bodies 0 means none, and a
+ * positive density only sets the centre of mass that torques are reported about (without
+ * one, the centroid of the enclosed volume). Bodies start at rest; a static body never
+ * moves. Fluid inside the body is not removed: place bodies clear of the fluid.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world, half_extents, pose or out_id NULL),
+ * `PF_ERROR_INVALID_ARGUMENT` (kind not a `PfBodyKind`; a density that is negative, NaN or
+ * infinite, or 0 for a dynamic body; a half-extent that is not positive and finite, named
+ * as `half_extents[i]`; a non-finite `pose.position`; a `pose.rotation` that is not finite
+ * or whose length differs from 1 by more than 1e-6; a body far larger than r or needing too
+ * many particles). On any error no body is added and `*out_id` is untouched.
+ * Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `half_extents` must be NULL or point to 3 readable doubles; `pose` must be NULL or point to a readable `PfPose`; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_body_box(struct PfWorld *world,
+                                    int kind,
+                                    const double *half_extents,
+                                    double density,
+                                    const struct PfPose *pose,
+                                    size_t *out_id);
+
+/**
+ * Adds a spherical rigid body of `radius` (m) centred on its frame's origin; otherwise as
+ * `pf_world_add_body_box` (the sphere is a subdivided icosahedron fine enough for r).
+ *
+ * Errors: as `pf_world_add_body_box`, with `radius` named when it is not positive and
+ * finite. On any error no body is added. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `pose` must be NULL or point to a readable `PfPose`; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_body_sphere(struct PfWorld *world,
+                                       int kind,
+                                       double radius,
+                                       double density,
+                                       const struct PfPose *pose,
+                                       size_t *out_id);
+
+/**
+ * Adds a cylindrical rigid body of `radius` and `height` (m) whose axis is its frame's y
+ * axis, centred on its frame's origin; otherwise as `pf_world_add_body_box`.
+ *
+ * Errors: as `pf_world_add_body_box`, with `radius` or `height` named when it is not
+ * positive and finite. On any error no body is added. Thread safety: one thread at a time
+ * per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `pose` must be NULL or point to a readable `PfPose`; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_body_cylinder(struct PfWorld *world,
+                                         int kind,
+                                         double radius,
+                                         double height,
+                                         double density,
+                                         const struct PfPose *pose,
+                                         size_t *out_id);
+
+/**
+ * Adds a rigid body whose surface is a triangle mesh given in the body's own frame, as in
+ * `pf_world_add_mesh`: `vertex_count` vertices `vertices` (3·vertex_count floats, m) and
+ * `triangle_count` triangles `indices` (3·triangle_count zero-based vertex indices). The
+ * mesh is copied and kept with the body. Otherwise as `pf_world_add_body_box`: a density
+ * (required for dynamic bodies) fills the mesh, which must then be closed and consistently
+ * oriented (either orientation).
+ *
+ * Errors: those of `pf_world_add_mesh` and of `pf_world_add_body_box`, plus
+ * `PF_ERROR_INVALID_ARGUMENT` for a density given with a mesh that encloses no volume. On
+ * any error no body is added. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `vertices` must be NULL or point to 3·vertex_count readable floats; `indices` must be NULL or point to 3·triangle_count readable `uint32_t`s; `pose` must be NULL or point to a readable `PfPose`; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_body_mesh(struct PfWorld *world,
+                                     int kind,
+                                     const float *vertices,
+                                     size_t vertex_count,
+                                     const uint32_t *indices,
+                                     size_t triangle_count,
+                                     double density,
+                                     const struct PfPose *pose,
+                                     size_t *out_id);
+
+/**
+ * Stores the number of bodies in `*out`; their ids are 0 to that number minus 1.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_body_count(const struct PfWorld *world, size_t *out);
+
+/**
+ * Moves kinematic or dynamic body `id` to `*pose` now (a teleport: its velocity stays, and
+ * the next step moves it on from there), cancelling a target pose set before. The pose is
+ * that of the body's frame (see `PfPose`).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or pose NULL), `PF_ERROR_INVALID_ARGUMENT` (an id
+ * that is not a body of the world, named in the message; a static body; a non-finite
+ * position; a rotation that is not finite or whose length differs from 1 by more than
+ * 1e-6). On any error the body is unchanged. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `pose` must be NULL or point to a readable `PfPose`.
+ */
+enum PfStatus pf_body_set_pose(struct PfWorld *world,
+                               size_t id,
+                               const struct PfPose *pose);
+
+/**
+ * Sets the velocity of kinematic or dynamic body `id`: `linear[0..3]`, of its centre of
+ * mass (m/s), and `angular[0..3]`, about its centre of mass (rad/s, world axes). The next
+ * step moves a kinematic body with it (and keeps it until it is set again); a dynamic body
+ * starts from it and gravity and the fluid change it. Cancels a target pose set before.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world, linear or angular NULL),
+ * `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named; a static body; a non-finite component,
+ * naming `linear` or `angular`). On any error the body is unchanged. Thread safety: one
+ * thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `linear` and `angular` must be NULL or point to 3 readable doubles.
+ */
+enum PfStatus pf_body_set_velocity(struct PfWorld *world,
+                                   size_t id,
+                                   const double *linear,
+                                   const double *angular);
+
+/**
+ * Sets where kinematic body `id` is to be at the end of the next step: the step moves it
+ * from its pose to `*pose`, with the velocity that takes it there in that step (linear of
+ * the centre of mass, angular as the rotation's axis times its angle over the step's size),
+ * which stays its velocity afterwards. Setting the pose or the velocity cancels it.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or pose NULL), `PF_ERROR_INVALID_ARGUMENT` (an
+ * unknown id, named; a body that is not kinematic; a bad pose, as in `pf_body_set_pose`).
+ * On any error the body is unchanged. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `pose` must be NULL or point to a readable `PfPose`.
+ */
+enum PfStatus pf_body_set_target_pose(struct PfWorld *world,
+                                      size_t id,
+                                      const struct PfPose *pose);
+
+/**
+ * Stores the kind of body `id` in `*out`.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named).
+ * Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_body_get_kind(const struct PfWorld *world, size_t id, enum PfBodyKind *out);
+
+/**
+ * Stores the current pose of body `id` (its frame's origin in m and its unit quaternion
+ * w, x, y, z) in `*out`. After a step, a moving body's pose is where the step left it.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named).
+ * Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_body_get_pose(const struct PfWorld *world, size_t id, struct PfPose *out);
+
+/**
+ * Copies the velocity of body `id` into `linear[0..3]` (its centre of mass, m/s) and
+ * `angular[0..3]` (about its centre of mass, rad/s, world axes). Static bodies report 0.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (either array NULL: neither is written),
+ * `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named). Thread safety: one thread at a time
+ * per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `linear` and `angular` must be NULL or point to 3 writable doubles.
+ */
+enum PfStatus pf_body_get_velocity(const struct PfWorld *world,
+                                   size_t id,
+                                   double *linear,
+                                   double *angular);
+
+/**
+ * Copies the centre of mass of body `id` in world coordinates (m) into `out[0..3]`: the
+ * point its velocity and torque refer to. With a density it is the centre of mass of the
+ * filled mesh; without, the centroid of the volume the mesh encloses (of its bounding box
+ * for an open mesh).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named).
+ * Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to 3 writable doubles.
+ */
+enum PfStatus pf_body_get_centre_of_mass(const struct PfWorld *world,
+                                         size_t id,
+                                         double *out);
+
+/**
+ * Copies the fluid's force on body `id` during the last step into `force[0..3]` (N) and its
+ * torque about the body's centre of mass into `torque[0..3]` (N·m); both are 0 before the
+ * first step. The loads are provisional: their distribution and scale are approximations
+ * (docs/method.md §11.3), accurate in sign but not yet in magnitude.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (either array NULL: neither is written),
+ * `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named). Thread safety: one thread at a time
+ * per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `force` and `torque` must be NULL or point to 3 writable doubles.
+ */
+enum PfStatus pf_body_get_force_torque(const struct PfWorld *world,
+                                       size_t id,
+                                       double *force,
+                                       double *torque);
+
+/**
+ * Copies the fluid's force on the container walls, static obstacles and boundary particles
+ * together during the last step into `force[0..3]` (N); static bodies report theirs
+ * separately (`pf_body_get_force_torque`). It is measured only in worlds with bodies, and
+ * is 0 otherwise and before the first step. Provisional, as the bodies' loads.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `force` must be NULL or point to 3 writable doubles.
+ */
+enum PfStatus pf_world_get_wall_force(const struct PfWorld *world,
+                                      double *force);
 
 #ifdef __cplusplus
 }  // extern "C"

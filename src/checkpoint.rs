@@ -2,14 +2,16 @@
 //! bit for bit as if it had never stopped.
 //!
 //! A checkpoint holds the world's exact state ([`WorldState`]) and the scene it was built
-//! from, with the world's parameters.
+//! from, with the world's parameters. A resumed world gets its bodies (meshes, samples and
+//! masses) from the scene, so a body's mesh file must still be readable, and their poses,
+//! velocities and loads from the state.
 //!
-//! Layout: the magic `PFCHECK1`; the length (u64, little-endian) of a JSON header, the
+//! Layout: the magic `PFCHECK2`; the length (u64, little-endian) of a JSON header, the
 //! header (the scene with the world's parameters, time, step count, next Δt, containers,
 //! grid, counts, the run's end, the online ρ_c estimate, the bodies' poses, velocities and
-//! loads); the fluid positions, velocities and densities as f64
-//! triples/values, the particle ids as u32, the static boundary positions as f64 triples and
-//! their owners as u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged or
+//! loads); the fluid positions, velocities and densities as f64 triples/values, the particle
+//! ids as u32, the static boundary positions as f64 triples and their owners as u32 (all
+//! little-endian); and a SHA-256 digest of everything before it, so that a damaged or
 //! truncated file is refused.
 
 use crate::body::{BodyState, Pose, Velocity};
@@ -280,7 +282,14 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         grid_capped: header.grid_capped,
         online_rho: header.chebyshev,
     };
+    // The bodies come from the scene (their meshes, samples and masses are not saved); the
+    // particles of the walls, obstacles and fluid come from the state.
     let mut world = World::new(scene.params.clone())?;
+    scene.add_bodies(&mut world).map_err(|e| {
+        bad(&format!(
+            "holds a scene whose bodies cannot be rebuilt: {e}"
+        ))
+    })?;
     world
         .import_state(state)
         .map_err(|e| bad(&format!("is inconsistent: {e}")))?;
@@ -313,121 +322,4 @@ impl Reader<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn temp(name: &str) -> std::path::PathBuf {
-        std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
-    }
-
-    fn small_scene() -> Scene {
-        let mut scene = Scene::builtin("dam_break_small").unwrap();
-        scene.fluid_blocks[0].count = [6, 8, 5];
-        scene
-    }
-
-    #[test]
-    fn a_resumed_world_continues_bit_for_bit() {
-        let scene = small_scene();
-        let mut reference = scene.build_world().unwrap();
-        let mut interrupted = scene.build_world().unwrap();
-        for _ in 0..15 {
-            reference.step().unwrap();
-            interrupted.step().unwrap();
-        }
-        let path = temp("resume.pfck");
-        write_checkpoint(&path, &scene, &interrupted, Some(RunEnd::Steps(30))).unwrap();
-        drop(interrupted);
-        let restored = read_checkpoint(&path, Some(3)).unwrap();
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!(restored.run_end, Some(RunEnd::Steps(30)));
-        assert_eq!(restored.world.thread_count(), 3);
-        let mut resumed = restored.world;
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert_eq!(resumed.boundary_positions(), reference.boundary_positions());
-        assert_eq!(resumed.boundary.psi, reference.boundary.psi);
-        for _ in 0..15 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-        }
-        assert_eq!(resumed.steps(), 30);
-        assert_eq!(resumed.time().to_bits(), reference.time().to_bits());
-        assert_eq!(resumed.next_dt().to_bits(), reference.next_dt().to_bits());
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert!(resumed.velocities() == reference.velocities());
-    }
-
-    /// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
-    /// one that forgot the estimate does not.
-    #[test]
-    fn a_resumed_world_keeps_its_online_rho() {
-        let mut scene = small_scene();
-        scene.params.chebyshev.auto_rho = true;
-        // A tight τ makes the steps long enough to measure.
-        scene.params.displacement_tolerance = 1e-4 * scene.params.particle_radius;
-        let mut reference = scene.build_world().unwrap();
-        for _ in 0..50 {
-            reference.step().unwrap();
-        }
-        let saved = reference.chebyshev.online();
-        assert!(saved.contraction.is_some(), "{saved:?}");
-        let path = temp("online-rho.pfck");
-        write_checkpoint(&path, &scene, &reference, None).unwrap();
-        let mut resumed = read_checkpoint(&path, None).unwrap().world;
-        let mut forgetful = read_checkpoint(&path, None).unwrap().world;
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!(resumed.chebyshev.online(), saved);
-        forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
-        for _ in 0..30 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-            forgetful.step().unwrap();
-        }
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert_ne!(forgetful.positions_hash(), reference.positions_hash());
-    }
-
-    #[test]
-    fn a_checkpoint_before_the_first_step_resumes_too() {
-        let scene = small_scene();
-        let mut reference = scene.build_world().unwrap();
-        let path = temp("fresh.pfck");
-        write_checkpoint(&path, &scene, &reference, None).unwrap();
-        let mut resumed = read_checkpoint(&path, None).unwrap().world;
-        std::fs::remove_file(&path).unwrap();
-        for _ in 0..5 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-        }
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-    }
-
-    #[test]
-    fn damaged_truncated_and_foreign_files_are_refused() {
-        let scene = small_scene();
-        let mut world = scene.build_world().unwrap();
-        world.step().unwrap();
-        let path = temp("damaged.pfck");
-        write_checkpoint(&path, &scene, &world, None).unwrap();
-        let good = std::fs::read(&path).unwrap();
-        let message = |bytes: &[u8]| {
-            std::fs::write(&path, bytes).unwrap();
-            match read_checkpoint(&path, None) {
-                Ok(_) => panic!("a bad checkpoint was accepted"),
-                Err(e) => e.to_string(),
-            }
-        };
-        let mut flipped = good.clone();
-        flipped[good.len() / 2] ^= 1;
-        let msg = message(&flipped);
-        assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-        assert!(msg.contains("damaged or truncated"), "{msg}");
-        assert!(message(&good[..good.len() - 100]).contains("damaged or truncated"));
-        assert!(message(&good[..20]).contains("truncated"));
-        assert!(message(b"{\"name\": 1}").contains("not a projfluid checkpoint"));
-        assert!(message(&[]).contains("not a projfluid checkpoint"));
-        std::fs::remove_file(&path).unwrap();
-        let msg = read_checkpoint(&path, None).err().unwrap().to_string();
-        assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
-    }
-}
+mod tests;

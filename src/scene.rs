@@ -1,5 +1,6 @@
-//! Scenes: a fluid setup (parameters, container boxes, blocks of fluid, duration, output)
-//! read from JSON (format in docs/scene-format.md) or taken from the built-in list.
+//! Scenes: a fluid setup (parameters, container boxes, obstacles, rigid bodies, blocks of
+//! fluid, duration, output) read from JSON (format in docs/scene-format.md) or taken from the
+//! built-in list.
 //!
 //! ```
 //! use projfluid::scene::Scene;
@@ -8,6 +9,7 @@
 //! assert_eq!(world.fluid_count(), 16 * 20 * 12);
 //! ```
 
+mod bodies;
 mod builtin;
 mod file;
 pub mod obstacle;
@@ -16,6 +18,7 @@ mod spec;
 mod test_support;
 mod validate;
 
+pub use bodies::{BodyShape, MotionSpec, SceneBody};
 pub use spec::{
     ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
 };
@@ -38,6 +41,8 @@ pub struct Scene {
     pub containers: Vec<ContainerSpec>,
     /// Static obstacles given as triangle meshes (may be empty).
     pub obstacles: Vec<ObstacleSpec>,
+    /// Rigid bodies: static, kinematic or dynamic (may be empty). Body `i` gets id `i`.
+    pub bodies: Vec<SceneBody>,
     /// Blocks of fluid (at least one).
     pub fluid_blocks: Vec<FluidBlock>,
     /// Simulated time to run (s).
@@ -109,7 +114,8 @@ impl Scene {
     }
 
     /// Checks the whole scene: parameters (named by their JSON keys, e.g. `solver.rho`),
-    /// duration, output, containers and fluid blocks (every particle centre inside a container).
+    /// duration, output, containers, obstacles, bodies (e.g. `bodies[1].density`) and fluid
+    /// blocks (every particle centre inside a container).
     pub fn validate(&self) -> Result<(), Error> {
         validate::validate(self)
     }
@@ -121,8 +127,9 @@ impl Scene {
             .fold(0usize, |acc, b| acc.saturating_add(b.particle_count()))
     }
 
-    /// A world with the scene's parameters, containers, obstacles and fluid, ready to step.
-    /// Obstacle meshes are read (or generated) here; their errors start with `obstacles[i]: `.
+    /// A world with the scene's parameters, containers, obstacles, bodies and fluid, ready to
+    /// step. Obstacle and body meshes are read (or generated) here; their errors start with
+    /// `obstacles[i]: ` or `bodies[i]: `.
     pub fn build_world(&self) -> Result<World, Error> {
         self.validate()?;
         let mut world = World::new(self.params.clone())?;
@@ -142,6 +149,7 @@ impl Scene {
                 .add_boundary_mesh(&mesh)
                 .map_err(|e| prefixed(e, &prefix))?;
         }
+        self.add_bodies(&mut world)?;
         for (i, b) in self.fluid_blocks.iter().enumerate() {
             world
                 .add_fluid_block(Vec3::from(b.start), b.count, Vec3::from(b.velocity))

@@ -16,6 +16,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
 
+#[path = "support/c_bodies.rs"]
+mod c_bodies;
 #[path = "support/tools.rs"]
 mod tools;
 
@@ -251,6 +253,31 @@ fn c_simulation_matches_the_rust_api_bit_for_bit() {
     );
 }
 
+/// Bodies from C: a kinematic paddle pushes water, a dynamic sphere falls freely, a target
+/// pose is reached, misuse is rejected changing no body, and the paddle tank matches the
+/// same scene built through the Rust API bit for bit (particles, bodies and loads).
+#[test]
+fn c_bodies_move_push_fall_reject_misuse_and_match_the_rust_api() {
+    let steps = 30;
+    let expected = c_bodies::paddle_report(steps);
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/bodies.c", link), &[&steps.to_string()]);
+        let last = out.lines().last().unwrap_or_default();
+        assert!(last.starts_with("bodies: ok"), "{link:?}: {out}");
+        let checked: usize = last
+            .split_whitespace()
+            .find_map(|w| w.parse().ok())
+            .expect("bodies prints the number of rejected calls");
+        assert!(checked >= 65, "only {checked} rejected calls were checked");
+        let report: String = out
+            .lines()
+            .filter(|l| ["hash ", "body ", "wall "].iter().any(|p| l.starts_with(p)))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        assert_eq!(report, expected, "{link:?}: C and Rust differ");
+    }
+}
+
 #[test]
 fn c_examples_build_and_run() {
     let out = run(&build("c_examples/minimal.c", Link::Static), &[]);
@@ -291,6 +318,7 @@ fn c_tests_are_clean_under_valgrind() {
         ("tests/c/mesh.c", &["0.01"][..]),
         ("tests/c/obj.c", &[obj_dir.as_str()][..]),
         ("tests/c/parallel.c", &["2"][..]),
+        ("tests/c/bodies.c", &["2"][..]),
     ] {
         let program = build(source, Link::Static);
         let output = Command::new("valgrind")

@@ -152,6 +152,25 @@ fn add_mesh(
     transform: Option<Transform>,
 ) -> Result<(), Failure> {
     let mut world = args.world(world)?;
+    let mut mesh = read_mesh(args, vertices, vertex_count, indices, triangle_count)?;
+    if let Some(t) = transform {
+        mesh = t
+            .apply(&mesh)
+            .map_err(|e| Failure::invalid(format!("after the transform, {e}")))?;
+    }
+    world.add_boundary_mesh(&mesh)?;
+    Ok(())
+}
+
+/// The validated mesh in the caller's arrays: `vertex_count` xyz float triples at
+/// `vertices` and `triangle_count` index triples at `indices` (see `pf_world_add_mesh`).
+pub(super) fn read_mesh(
+    args: Args,
+    vertices: *const f32,
+    vertex_count: usize,
+    indices: *const u32,
+    triangle_count: usize,
+) -> Result<TriangleMesh, Failure> {
     check_count(vertex_count).map_err(|f| named(f, "vertex_count"))?;
     check_count(triangle_count).map_err(|f| named(f, "triangle_count"))?;
     let positions = read_vectors(args, vertices, vertex_count, "vertices")?;
@@ -162,14 +181,7 @@ fn add_mesh(
         .try_reserve_exact(triangle_count)
         .map_err(|_| Failure::out_of_memory("indices"))?;
     triangles.extend(flat.chunks_exact(3).map(|t| [t[0], t[1], t[2]]));
-    let mut mesh = TriangleMesh::new(positions, triangles)?;
-    if let Some(t) = transform {
-        mesh = t
-            .apply(&mesh)
-            .map_err(|e| Failure::invalid(format!("after the transform, {e}")))?;
-    }
-    world.add_boundary_mesh(&mesh)?;
-    Ok(())
+    Ok(TriangleMesh::new(positions, triangles)?)
 }
 
 /// Adds a static obstacle read from the Wavefront OBJ file at `path` (a NUL-terminated

@@ -10,7 +10,8 @@
 //!   (`PF_ERROR_PANIC`) and records the message; its pointer arguments are reached only
 //!   through `checked::Args`, which checks them (`PF_ERROR_NULL_POINTER`, misalignment).
 //! - Arrays of 3-vectors are flat `x, y, z, x, y, z, …` `float` arrays in metres (positions)
-//!   or m/s (velocities). Particles are reported in the order they were added.
+//!   or m/s (velocities). Particles are reported in the order they were added. Rigid bodies
+//!   (`body`) take and report `double` vectors and poses, and are addressed by their id.
 //! - Thread safety: one world must not be used from two threads at once (a call that finds
 //!   the world busy returns `PF_ERROR_BUSY`); distinct worlds may be used in parallel.
 
@@ -21,6 +22,10 @@ mod status;
 mod version;
 mod world;
 
+// Declared after `world` so that cbindgen lists the body functions after the world's.
+mod body;
+
+pub use body::*;
 pub use mesh::*;
 pub use params::{PfOmega2Rule, PfParams, PfProjectionWeight, PfSolver};
 pub use params::{pf_params_default, pf_params_validate};

@@ -1,6 +1,7 @@
 //! The JSON form of a scene: serde structures mirroring docs/scene-format.md and their
 //! conversion to and from [`Scene`].
 
+mod bodies;
 mod error;
 mod obstacles;
 mod print;
@@ -10,6 +11,7 @@ mod tests;
 use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
 use crate::Error;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+use bodies::BodyFile;
 use error::json_error;
 use obstacles::ObstacleFile;
 use print::inline_number_arrays;
@@ -34,6 +36,8 @@ struct SceneFile {
     container: Option<Containers>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     obstacles: Option<Vec<ObstacleFile>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    bodies: Option<Vec<BodyFile>>,
     fluid_blocks: Vec<FluidBlock>,
     solver: Option<SolverFile>,
     time: Option<TimeFile>,
@@ -203,7 +207,14 @@ impl SceneFile {
             .unwrap_or_default()
             .into_iter()
             .enumerate()
-            .map(|(i, o)| o.into_spec(i, base))
+            .map(|(i, o)| o.into_spec(&format!("obstacles[{i}]"), base))
+            .collect::<Result<_, _>>()?;
+        let bodies = self
+            .bodies
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+            .map(|(i, b)| b.into_body(i, base))
             .collect::<Result<_, _>>()?;
         let o = self.output.unwrap_or_default();
         Ok(Scene {
@@ -212,6 +223,7 @@ impl SceneFile {
             params: p,
             containers: self.container.map(|c| c.0).unwrap_or_default(),
             obstacles,
+            bodies,
             fluid_blocks: self.fluid_blocks,
             duration: self.duration,
             output: OutputSpec {
@@ -242,6 +254,8 @@ impl SceneFile {
                     .collect(),
             )
             .filter(|o: &Vec<ObstacleFile>| !o.is_empty()),
+            bodies: Some(scene.bodies.iter().map(BodyFile::from_body).collect())
+                .filter(|b: &Vec<BodyFile>| !b.is_empty()),
             fluid_blocks: scene.fluid_blocks.clone(),
             solver: Some(SolverFile {
                 kind: Some(p.solver),

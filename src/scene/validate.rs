@@ -1,6 +1,6 @@
 //! Checks of a [`Scene`]'s values; errors name the JSON key and the value.
 
-use super::{ContainerSpec, FluidBlock, Scene};
+use super::{ContainerSpec, FluidBlock, ObstacleSpec, Scene};
 use crate::Error;
 
 /// The most fluid particles a world accepts (see `World::add_fluid_particles`).
@@ -38,25 +38,10 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
         check_container(i, c, r)?;
     }
     for (i, o) in scene.obstacles.iter().enumerate() {
-        if let super::MeshSource::Generated(name) = &o.mesh
-            && !super::obstacle::NAMES.contains(&name.as_str())
-        {
-            return Err(Error::invalid(
-                format!("obstacles[{i}].generated"),
-                format!("`{name}`"),
-                &format!(
-                    "must name a generated mesh ({})",
-                    super::obstacle::NAMES.join(", ")
-                ),
-            ));
-        }
-        o.transform.validate().map_err(|e| match e {
-            Error::InvalidArgument { field, message } => Error::InvalidArgument {
-                field: format!("obstacles[{i}].{field}"),
-                message: format!("obstacles[{i}].{message}"),
-            },
-            other => other,
-        })?;
+        check_mesh_source(&format!("obstacles[{i}]"), o)?;
+    }
+    for (i, b) in scene.bodies.iter().enumerate() {
+        super::bodies::check_body(i, b)?;
     }
     if scene.fluid_blocks.is_empty() {
         return Err(Error::invalid(
@@ -79,6 +64,30 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
         check_inside(i, b, &scene.containers, 2.0 * r)?;
     }
     Ok(())
+}
+
+/// An obstacle-style mesh source (the obstacle or body mesh at JSON key `key`): a known
+/// generated mesh, and a valid transform.
+pub(super) fn check_mesh_source(key: &str, o: &ObstacleSpec) -> Result<(), Error> {
+    if let super::MeshSource::Generated(name) = &o.mesh
+        && !super::obstacle::NAMES.contains(&name.as_str())
+    {
+        return Err(Error::invalid(
+            format!("{key}.generated"),
+            format!("`{name}`"),
+            &format!(
+                "must name a generated mesh ({})",
+                super::obstacle::NAMES.join(", ")
+            ),
+        ));
+    }
+    o.transform.validate().map_err(|e| match e {
+        Error::InvalidArgument { field, message } => Error::InvalidArgument {
+            field: format!("{key}.{field}"),
+            message: format!("{key}.{message}"),
+        },
+        other => other,
+    })
 }
 
 /// Renames a [`crate::Params::validate`] error's field to its JSON key (e.g. `rho` → `solver.rho`).

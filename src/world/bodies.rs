@@ -58,7 +58,11 @@ impl World {
         let psi = if kind == BodyKind::Static {
             Vec::new()
         } else {
-            own_masses(&samples, &self.constraint.kernel, self.params.rest_density)
+            // On the world's own pool: rayon's global pool would start threads that outlive
+            // the world (and that the C API's pf_world_destroy could not join).
+            let (kernel, rest_density) = (&self.constraint.kernel, self.params.rest_density);
+            self.pool
+                .install(|| own_masses(&samples, kernel, rest_density))
         };
         let body = spec.build(samples, psi)?;
         if kind == BodyKind::Static {

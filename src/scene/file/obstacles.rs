@@ -30,8 +30,8 @@ enum Scale {
 
 impl ObstacleFile {
     /// The obstacle, with a relative `obj` path taken relative to `base` (the scene file's
-    /// directory, if any). `i` names the entry in errors.
-    pub(super) fn into_spec(self, i: usize, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
+    /// directory, if any). `key` names the entry in errors (e.g. `obstacles[2]`).
+    pub(super) fn into_spec(self, key: &str, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
         let mesh = match (self.obj, self.generated) {
             (Some(obj), None) => {
                 let path = PathBuf::from(obj);
@@ -43,9 +43,9 @@ impl ObstacleFile {
             (None, Some(name)) => MeshSource::Generated(name),
             _ => {
                 return Err(Error::InvalidArgument {
-                    field: format!("obstacles[{i}]"),
+                    field: key.to_string(),
                     message: format!(
-                        "obstacles[{i}] needs exactly one mesh: `obj` (an OBJ file path) or \
+                        "{key} needs exactly one mesh: `obj` (an OBJ file path) or \
                          `generated` (one of {})",
                         crate::scene::obstacle::NAMES.join(", ")
                     ),

@@ -1,0 +1,181 @@
+//! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, before
+//! the first step, and with rigid bodies), and refused damaged, truncated and foreign files.
+
+use super::*;
+
+fn temp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
+}
+
+fn small_scene() -> Scene {
+    let mut scene = Scene::builtin("dam_break_small").unwrap();
+    scene.fluid_blocks[0].count = [6, 8, 5];
+    scene
+}
+
+#[test]
+fn a_resumed_world_continues_bit_for_bit() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let mut interrupted = scene.build_world().unwrap();
+    for _ in 0..15 {
+        reference.step().unwrap();
+        interrupted.step().unwrap();
+    }
+    let path = temp("resume.pfck");
+    write_checkpoint(&path, &scene, &interrupted, Some(RunEnd::Steps(30))).unwrap();
+    drop(interrupted);
+    let restored = read_checkpoint(&path, Some(3)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(restored.run_end, Some(RunEnd::Steps(30)));
+    assert_eq!(restored.world.thread_count(), 3);
+    let mut resumed = restored.world;
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_eq!(resumed.boundary_positions(), reference.boundary_positions());
+    assert_eq!(resumed.boundary.psi, reference.boundary.psi);
+    for _ in 0..15 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.steps(), 30);
+    assert_eq!(resumed.time().to_bits(), reference.time().to_bits());
+    assert_eq!(resumed.next_dt().to_bits(), reference.next_dt().to_bits());
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert!(resumed.velocities() == reference.velocities());
+}
+
+/// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
+/// one that forgot the estimate does not.
+#[test]
+fn a_resumed_world_keeps_its_online_rho() {
+    let mut scene = small_scene();
+    scene.params.chebyshev.auto_rho = true;
+    // A tight τ makes the steps long enough to measure.
+    scene.params.displacement_tolerance = 1e-4 * scene.params.particle_radius;
+    let mut reference = scene.build_world().unwrap();
+    for _ in 0..50 {
+        reference.step().unwrap();
+    }
+    let saved = reference.chebyshev.online();
+    assert!(saved.contraction.is_some(), "{saved:?}");
+    let path = temp("online-rho.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    let mut forgetful = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.chebyshev.online(), saved);
+    forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
+    for _ in 0..30 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+        forgetful.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_ne!(forgetful.positions_hash(), reference.positions_hash());
+}
+
+#[test]
+fn a_checkpoint_before_the_first_step_resumes_too() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let path = temp("fresh.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    for _ in 0..5 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+}
+
+#[test]
+fn damaged_truncated_and_foreign_files_are_refused() {
+    let scene = small_scene();
+    let mut world = scene.build_world().unwrap();
+    world.step().unwrap();
+    let path = temp("damaged.pfck");
+    write_checkpoint(&path, &scene, &world, None).unwrap();
+    let good = std::fs::read(&path).unwrap();
+    let message = |bytes: &[u8]| {
+        std::fs::write(&path, bytes).unwrap();
+        match read_checkpoint(&path, None) {
+            Ok(_) => panic!("a bad checkpoint was accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 1;
+    let msg = message(&flipped);
+    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+    assert!(msg.contains("damaged or truncated"), "{msg}");
+    assert!(message(&good[..good.len() - 100]).contains("damaged or truncated"));
+    assert!(message(&good[..20]).contains("truncated"));
+    assert!(message(b"{\"name\": 1}").contains("not a projfluid checkpoint"));
+    assert!(message(&[]).contains("not a projfluid checkpoint"));
+    std::fs::remove_file(&path).unwrap();
+    let msg = read_checkpoint(&path, None).err().unwrap().to_string();
+    assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
+}
+
+/// `small_scene` with a scripted kinematic paddle beyond the water, a dynamic box above it
+/// (spinning) and a static ball on the floor.
+fn scene_with_bodies() -> Scene {
+    let text = r#"[
+        {"kind": "kinematic", "box": {"half_extents": [0.02, 0.3, 0.3]}, "position": [0.4, 0.32, 0.325],
+         "motion": {"amplitude": [0.05, 0, 0], "angular_amplitude": [0, 0, 0.2], "period": 0.5}},
+        {"kind": "dynamic", "box": {"half_extents": [0.06, 0.05, 0.06]}, "density": 600,
+         "position": [0.15, 0.6, 0.15], "angular_velocity": [0, 0, 2]},
+        {"kind": "static", "sphere": {"radius": 0.08}, "position": [1.2, 0.1, 0.3]}
+    ]"#;
+    let mut json = small_scene().to_json();
+    let end = json.rfind('}').unwrap();
+    json.replace_range(end.., &format!(", \"bodies\": {text}}}"));
+    Scene::from_json(&json).unwrap()
+}
+
+/// The particles' digest, every body's state and the walls' load, as bits.
+fn fingerprint(world: &World) -> (String, Vec<BodyState>, Vec3, u64) {
+    let bodies = world.bodies().iter().map(|b| b.state()).collect();
+    (
+        world.positions_hash(),
+        bodies,
+        world.wall_force(),
+        world.time().to_bits(),
+    )
+}
+
+#[test]
+fn a_resumed_world_with_bodies_continues_bit_for_bit() {
+    let scene = scene_with_bodies();
+    let mut reference = scene.build_world().unwrap();
+    let mut interrupted = scene.build_world().unwrap();
+    assert_eq!(reference.bodies().len(), 3);
+    for _ in 0..20 {
+        reference.step().unwrap();
+        interrupted.step().unwrap();
+    }
+    let path = temp("bodies.pfck");
+    write_checkpoint(&path, &scene, &interrupted, None).unwrap();
+    drop(interrupted);
+    let restored = read_checkpoint(&path, Some(1)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(restored.scene.bodies, scene.bodies);
+    let mut resumed = restored.world;
+    // The walls' load of the last step is not part of the state; everything else is.
+    let without_walls = |w: &World| {
+        let (hash, bodies, _, time) = fingerprint(w);
+        (hash, bodies, time)
+    };
+    assert_eq!(without_walls(&resumed), without_walls(&reference));
+    let start: Vec<BodyState> = reference.bodies().iter().map(|b| b.state()).collect();
+    for _ in 0..20 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(fingerprint(&resumed), fingerprint(&reference));
+    // The paddle and the box moved on after the checkpoint.
+    for id in [0, 1] {
+        assert_ne!(reference.bodies()[id].pose(), start[id].pose, "body {id}");
+    }
+}

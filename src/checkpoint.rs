@@ -4,26 +4,29 @@
 //! A checkpoint holds the world's exact state ([`WorldState`]) and the scene it was built
 //! from, with the world's parameters.
 //!
-//! Layout: the magic `PFCHECK1`; the length (u64, little-endian) of a JSON header, the
-//! header (the scene with the world's parameters, time, step count, next Δt, containers,
-//! grid, counts, the run's end, the online ρ_c estimate, the bodies' poses, velocities and
-//! loads); the fluid positions, velocities and densities as f64
-//! triples/values, the particle ids as u32, the static boundary positions as f64 triples and
-//! their owners as u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged or
-//! truncated file is refused.
+//! Layout: the magic `PFCHECK3`; the length (u64, little-endian) of a JSON header, the
+//! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
+//! containers, grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
+//! velocities and loads, the next particle id, the removed count, sinks, domain and
+//! emitters); the fluid positions, velocities and densities as f64 triples/values, the
+//! particle ids as u64, the static boundary positions as f64 triples and their owners as
+//! u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged
+//! or truncated file is refused.
 
-use crate::body::{BodyState, Pose, Velocity};
-use crate::boundary::Aabb;
+mod header;
+
 use crate::scene::Scene;
-use crate::solver::OnlineRho;
-use crate::{Error, GridParts, Vec3, World, WorldState};
+use crate::{Error, Vec3, World, WorldState};
+use header::{Header, SavedBody, SavedEmitter, aabb, saved_box};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK2";
-/// The magic of the format before bodies, named in the error that refuses it.
+const MAGIC: &[u8; 8] = b"PFCHECK3";
+/// The magics of earlier formats, named in the errors that refuse them: before bodies, and
+/// before particle ids, sinks and emitters.
 const MAGIC_V1: &[u8; 8] = b"PFCHECK1";
+const MAGIC_V2: &[u8; 8] = b"PFCHECK2";
 const DIGEST_LEN: usize = 32;
 
 /// Where the interrupted run was going to stop.
@@ -47,73 +50,6 @@ pub struct Checkpoint {
     pub run_end: Option<RunEnd>,
 }
 
-/// The JSON header.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Header {
-    scene: String,
-    time: f64,
-    steps: u64,
-    next_dt: f64,
-    containers: Vec<[[f64; 3]; 2]>,
-    grid: Option<GridParts>,
-    grid_capped: bool,
-    boundary_dirty: bool,
-    fluid_count: usize,
-    boundary_count: usize,
-    run_end: Option<RunEnd>,
-    chebyshev: OnlineRho,
-    bodies: Vec<SavedBody>,
-}
-
-/// A body's changing state in the header, every number exact (serde_json round-trips f64).
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SavedBody {
-    /// Position (m) and quaternion [w, x, y, z].
-    pose: ([f64; 3], [f64; 4]),
-    /// Linear (m/s) and angular (rad/s) velocity.
-    velocity: [[f64; 3]; 2],
-    target: Option<([f64; 3], [f64; 4])>,
-    /// Force (N) and torque (N·m).
-    load: [[f64; 3]; 2],
-}
-
-impl SavedBody {
-    fn of(b: &BodyState) -> Self {
-        let pose = |p: &Pose| (p.position.into(), p.wxyz());
-        Self {
-            pose: pose(&b.pose),
-            velocity: [b.velocity.linear.into(), b.velocity.angular.into()],
-            target: b.target.as_ref().map(pose),
-            load: [b.force.into(), b.torque.into()],
-        }
-    }
-
-    /// The state, or an error naming what is not a valid pose.
-    fn state(&self) -> Result<BodyState, Error> {
-        let pose = |(x, q): &([f64; 3], [f64; 4])| {
-            // Stored quaternions are unit to round-off; keep them exactly as saved.
-            Pose::from_parts(Vec3::from(*x), *q).map(|_| Pose {
-                position: Vec3::from(*x),
-                rotation: crate::body::Rotation::new_unchecked(nalgebra::Quaternion::new(
-                    q[0], q[1], q[2], q[3],
-                )),
-            })
-        };
-        Ok(BodyState {
-            pose: pose(&self.pose)?,
-            velocity: Velocity {
-                linear: Vec3::from(self.velocity[0]),
-                angular: Vec3::from(self.velocity[1]),
-            },
-            target: self.target.as_ref().map(pose).transpose()?,
-            force: Vec3::from(self.load[0]),
-            torque: Vec3::from(self.load[1]),
-        })
-    }
-}
-
 /// Writes a checkpoint of `world`, which was built from `scene`, to `path` (through a
 /// temporary file renamed into place, so that an interrupted write never leaves a partial
 /// checkpoint under that name). `run_end` records where the run was going to stop.
@@ -131,11 +67,7 @@ pub fn write_checkpoint(
         time: state.time,
         steps: state.steps,
         next_dt: state.next_dt,
-        containers: state
-            .containers
-            .iter()
-            .map(|c| [c.min.into(), c.max.into()])
-            .collect(),
+        containers: state.containers.iter().map(saved_box).collect(),
         grid: state.grid,
         grid_capped: state.grid_capped,
         boundary_dirty: !state.boundary_sorted,
@@ -144,12 +76,17 @@ pub fn write_checkpoint(
         run_end,
         chebyshev: state.online_rho,
         bodies: state.bodies.iter().map(SavedBody::of).collect(),
+        next_id: state.next_id,
+        removed_count: state.removed_count,
+        sinks: state.sinks.iter().map(saved_box).collect(),
+        domain: state.domain.as_ref().map(saved_box),
+        emitters: state.emitters.iter().map(SavedEmitter::of).collect(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
     let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 60 + f.boundary_positions.len() * 28,
+        64 + json.len() + f.positions.len() * 64 + f.boundary_positions.len() * 28,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
@@ -203,6 +140,12 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
             "is a checkpoint of an earlier version without bodies, which this version cannot resume",
         ));
     }
+    if bytes.starts_with(MAGIC_V2) {
+        return Err(bad(
+            "is a checkpoint of an earlier version without stable particle ids, sinks and \
+             emitters, which this version cannot resume",
+        ));
+    }
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
@@ -229,7 +172,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
     let (n, m) = (header.fluid_count, header.boundary_count);
     let expected = n
-        .checked_mul(3 * 8 * 2 + 8 + 4)
+        .checked_mul(3 * 8 * 2 + 8 + 8)
         .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
@@ -247,7 +190,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let positions = data.vec3s(n);
     let velocities = data.vec3s(n);
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
-    let ids: Vec<u32> = (0..n).map(|_| u32::from_le_bytes(data.take())).collect();
+    let ids: Vec<u64> = (0..n).map(|_| u64::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
     let owners: Vec<u32> = (0..m).map(|_| u32::from_le_bytes(data.take())).collect();
     let bodies = header
@@ -264,18 +207,16 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         velocities,
         densities,
         ids,
+        next_id: header.next_id,
+        removed_count: header.removed_count,
         boundary_positions: boundary,
         boundary_owners: owners,
         bodies,
         boundary_sorted: !header.boundary_dirty,
-        containers: header
-            .containers
-            .iter()
-            .map(|[min, max]| Aabb {
-                min: Vec3::from(*min),
-                max: Vec3::from(*max),
-            })
-            .collect(),
+        containers: header.containers.iter().map(aabb).collect(),
+        sinks: header.sinks.iter().map(aabb).collect(),
+        domain: header.domain.as_ref().map(aabb),
+        emitters: header.emitters.iter().map(SavedEmitter::state).collect(),
         grid: header.grid,
         grid_capped: header.grid_capped,
         online_rho: header.chebyshev,
@@ -313,121 +254,4 @@ impl Reader<'_> {
 }
 
 #[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn temp(name: &str) -> std::path::PathBuf {
-        std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
-    }
-
-    fn small_scene() -> Scene {
-        let mut scene = Scene::builtin("dam_break_small").unwrap();
-        scene.fluid_blocks[0].count = [6, 8, 5];
-        scene
-    }
-
-    #[test]
-    fn a_resumed_world_continues_bit_for_bit() {
-        let scene = small_scene();
-        let mut reference = scene.build_world().unwrap();
-        let mut interrupted = scene.build_world().unwrap();
-        for _ in 0..15 {
-            reference.step().unwrap();
-            interrupted.step().unwrap();
-        }
-        let path = temp("resume.pfck");
-        write_checkpoint(&path, &scene, &interrupted, Some(RunEnd::Steps(30))).unwrap();
-        drop(interrupted);
-        let restored = read_checkpoint(&path, Some(3)).unwrap();
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!(restored.run_end, Some(RunEnd::Steps(30)));
-        assert_eq!(restored.world.thread_count(), 3);
-        let mut resumed = restored.world;
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert_eq!(resumed.boundary_positions(), reference.boundary_positions());
-        assert_eq!(resumed.boundary.psi, reference.boundary.psi);
-        for _ in 0..15 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-        }
-        assert_eq!(resumed.steps(), 30);
-        assert_eq!(resumed.time().to_bits(), reference.time().to_bits());
-        assert_eq!(resumed.next_dt().to_bits(), reference.next_dt().to_bits());
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert!(resumed.velocities() == reference.velocities());
-    }
-
-    /// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
-    /// one that forgot the estimate does not.
-    #[test]
-    fn a_resumed_world_keeps_its_online_rho() {
-        let mut scene = small_scene();
-        scene.params.chebyshev.auto_rho = true;
-        // A tight τ makes the steps long enough to measure.
-        scene.params.displacement_tolerance = 1e-4 * scene.params.particle_radius;
-        let mut reference = scene.build_world().unwrap();
-        for _ in 0..50 {
-            reference.step().unwrap();
-        }
-        let saved = reference.chebyshev.online();
-        assert!(saved.contraction.is_some(), "{saved:?}");
-        let path = temp("online-rho.pfck");
-        write_checkpoint(&path, &scene, &reference, None).unwrap();
-        let mut resumed = read_checkpoint(&path, None).unwrap().world;
-        let mut forgetful = read_checkpoint(&path, None).unwrap().world;
-        std::fs::remove_file(&path).unwrap();
-        assert_eq!(resumed.chebyshev.online(), saved);
-        forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
-        for _ in 0..30 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-            forgetful.step().unwrap();
-        }
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-        assert_ne!(forgetful.positions_hash(), reference.positions_hash());
-    }
-
-    #[test]
-    fn a_checkpoint_before_the_first_step_resumes_too() {
-        let scene = small_scene();
-        let mut reference = scene.build_world().unwrap();
-        let path = temp("fresh.pfck");
-        write_checkpoint(&path, &scene, &reference, None).unwrap();
-        let mut resumed = read_checkpoint(&path, None).unwrap().world;
-        std::fs::remove_file(&path).unwrap();
-        for _ in 0..5 {
-            reference.step().unwrap();
-            resumed.step().unwrap();
-        }
-        assert_eq!(resumed.positions_hash(), reference.positions_hash());
-    }
-
-    #[test]
-    fn damaged_truncated_and_foreign_files_are_refused() {
-        let scene = small_scene();
-        let mut world = scene.build_world().unwrap();
-        world.step().unwrap();
-        let path = temp("damaged.pfck");
-        write_checkpoint(&path, &scene, &world, None).unwrap();
-        let good = std::fs::read(&path).unwrap();
-        let message = |bytes: &[u8]| {
-            std::fs::write(&path, bytes).unwrap();
-            match read_checkpoint(&path, None) {
-                Ok(_) => panic!("a bad checkpoint was accepted"),
-                Err(e) => e.to_string(),
-            }
-        };
-        let mut flipped = good.clone();
-        flipped[good.len() / 2] ^= 1;
-        let msg = message(&flipped);
-        assert!(msg.starts_with(&path.display().to_string()), "{msg}");
-        assert!(msg.contains("damaged or truncated"), "{msg}");
-        assert!(message(&good[..good.len() - 100]).contains("damaged or truncated"));
-        assert!(message(&good[..20]).contains("truncated"));
-        assert!(message(b"{\"name\": 1}").contains("not a projfluid checkpoint"));
-        assert!(message(&[]).contains("not a projfluid checkpoint"));
-        std::fs::remove_file(&path).unwrap();
-        let msg = read_checkpoint(&path, None).err().unwrap().to_string();
-        assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
-    }
-}
+mod tests;

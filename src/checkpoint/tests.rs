@@ -1,0 +1,184 @@
+//! Checkpoints written and read back: resumed runs continue bit for bit, bad files are
+//! refused.
+
+use super::*;
+
+fn temp(name: &str) -> std::path::PathBuf {
+    std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
+}
+
+fn small_scene() -> Scene {
+    let mut scene = Scene::builtin("dam_break_small").unwrap();
+    scene.fluid_blocks[0].count = [6, 8, 5];
+    scene
+}
+
+#[test]
+fn a_resumed_world_continues_bit_for_bit() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let mut interrupted = scene.build_world().unwrap();
+    for _ in 0..15 {
+        reference.step().unwrap();
+        interrupted.step().unwrap();
+    }
+    let path = temp("resume.pfck");
+    write_checkpoint(&path, &scene, &interrupted, Some(RunEnd::Steps(30))).unwrap();
+    drop(interrupted);
+    let restored = read_checkpoint(&path, Some(3)).unwrap();
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(restored.run_end, Some(RunEnd::Steps(30)));
+    assert_eq!(restored.world.thread_count(), 3);
+    let mut resumed = restored.world;
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_eq!(resumed.boundary_positions(), reference.boundary_positions());
+    assert_eq!(resumed.boundary.psi, reference.boundary.psi);
+    for _ in 0..15 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.steps(), 30);
+    assert_eq!(resumed.time().to_bits(), reference.time().to_bits());
+    assert_eq!(resumed.next_dt().to_bits(), reference.next_dt().to_bits());
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert!(resumed.velocities() == reference.velocities());
+}
+
+/// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
+/// one that forgot the estimate does not.
+#[test]
+fn a_resumed_world_keeps_its_online_rho() {
+    let mut scene = small_scene();
+    scene.params.chebyshev.auto_rho = true;
+    // A tight τ makes the steps long enough to measure.
+    scene.params.displacement_tolerance = 1e-4 * scene.params.particle_radius;
+    let mut reference = scene.build_world().unwrap();
+    for _ in 0..50 {
+        reference.step().unwrap();
+    }
+    let saved = reference.chebyshev.online();
+    assert!(saved.contraction.is_some(), "{saved:?}");
+    let path = temp("online-rho.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    let mut forgetful = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.chebyshev.online(), saved);
+    forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
+    for _ in 0..30 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+        forgetful.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_ne!(forgetful.positions_hash(), reference.positions_hash());
+}
+
+#[test]
+fn a_checkpoint_before_the_first_step_resumes_too() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let path = temp("fresh.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    for _ in 0..5 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+}
+
+#[test]
+fn damaged_truncated_and_foreign_files_are_refused() {
+    let scene = small_scene();
+    let mut world = scene.build_world().unwrap();
+    world.step().unwrap();
+    let path = temp("damaged.pfck");
+    write_checkpoint(&path, &scene, &world, None).unwrap();
+    let good = std::fs::read(&path).unwrap();
+    let message = |bytes: &[u8]| {
+        std::fs::write(&path, bytes).unwrap();
+        match read_checkpoint(&path, None) {
+            Ok(_) => panic!("a bad checkpoint was accepted"),
+            Err(e) => e.to_string(),
+        }
+    };
+    let mut flipped = good.clone();
+    flipped[good.len() / 2] ^= 1;
+    let msg = message(&flipped);
+    assert!(msg.starts_with(&path.display().to_string()), "{msg}");
+    assert!(msg.contains("damaged or truncated"), "{msg}");
+    assert!(message(&good[..good.len() - 100]).contains("damaged or truncated"));
+    assert!(message(&good[..20]).contains("truncated"));
+    assert!(message(b"{\"name\": 1}").contains("not a projfluid checkpoint"));
+    assert!(message(&[]).contains("not a projfluid checkpoint"));
+    std::fs::remove_file(&path).unwrap();
+    let msg = read_checkpoint(&path, None).err().unwrap().to_string();
+    assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
+}
+
+/// A run with an emitter, a sink, a domain and removed particles resumes bit for bit: ids,
+/// the removed count, the emitter's progress and the boxes are in the checkpoint.
+#[test]
+fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
+    use crate::{EmitterShape, EmitterSpec};
+    let scene = small_scene();
+    let build = || {
+        let mut world = scene.build_world().unwrap();
+        let spec = EmitterSpec {
+            shape: EmitterShape::Disc { radius: 0.08 },
+            position: Vec3::new(0.15, 0.7, 0.3),
+            direction: Vec3::new(0.3, -1.0, 0.0),
+            speed: 1.2,
+            end_time: Some(0.5),
+        };
+        world.add_emitter(spec).unwrap();
+        let sink = crate::boundary::Aabb {
+            min: Vec3::new(0.0, 0.0, 0.0),
+            max: Vec3::new(0.15, 0.2, 0.65),
+        };
+        world.add_sink(sink).unwrap();
+        let mut domain = world.containers()[0];
+        domain.max.x = 0.28;
+        world.set_domain(Some(domain)).unwrap();
+        world
+    };
+    let mut reference = build();
+    let mut interrupted = build();
+    for _ in 0..20 {
+        reference.step().unwrap();
+        interrupted.step().unwrap();
+    }
+    assert!(reference.removed_count() > 0 && reference.emitted_count() > 0);
+    let path = temp("emitters.pfck");
+    write_checkpoint(&path, &scene, &interrupted, None).unwrap();
+    drop(interrupted);
+    let mut resumed = read_checkpoint(&path, Some(1)).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.export_state(), reference.export_state());
+    for _ in 0..20 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.ids(), reference.ids());
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_eq!(resumed.export_state(), reference.export_state());
+}
+
+/// A checkpoint of the format before stable ids is refused with a message saying so.
+#[test]
+fn checkpoints_of_earlier_formats_are_refused() {
+    let path = temp("v2.pfck");
+    for (magic, words) in [
+        (MAGIC_V2, "stable particle ids"),
+        (MAGIC_V1, "without bodies"),
+    ] {
+        let mut bytes = magic.to_vec();
+        bytes.extend_from_slice(&[0; 64]);
+        std::fs::write(&path, bytes).unwrap();
+        let message = read_checkpoint(&path, None).err().unwrap().to_string();
+        assert!(message.contains(words), "{message}");
+    }
+    std::fs::remove_file(&path).unwrap();
+}

@@ -665,11 +665,12 @@ enum PfStatus pf_world_get_params(const struct PfWorld *world, struct PfParams *
 enum PfStatus pf_world_last_step_stats(const struct PfWorld *world, struct PfStepStats *out);
 
 /**
- * Copies the fluid positions (m) into `out` as x, y, z floats per particle, in the order
- * the particles were added. `capacity_floats` is the length of `out` in floats; 3·fluid
- * count are needed and written. `*needed` (when `needed` is not NULL) receives that number
- * on success and on `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out` is untouched. `out`
- * may be NULL only with capacity 0, to query the size. The world is not changed.
+ * Copies the fluid positions (m) into `out` as x, y, z floats per particle, in ascending id
+ * order (the order the particles were added, removed ones skipped; see `pf_world_get_ids`).
+ * `capacity_floats` is the length of `out` in floats; 3·fluid count are needed and written.
+ * `*needed` (when `needed` is not NULL) receives that number on success and on
+ * `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out` is untouched. `out` may be NULL only with
+ * capacity 0, to query the size. The world is not changed.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity_floats` writable floats; `needed` must be NULL or writable.
@@ -692,7 +693,7 @@ enum PfStatus pf_world_get_velocities(const struct PfWorld *world,
 
 /**
  * Copies the fluid densities (kg/m³, 0 before the first step) into `out`, one float per
- * particle in the order the particles were added; otherwise like `pf_world_get_positions`.
+ * particle in ascending id order; otherwise like `pf_world_get_positions`.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity_floats` writable floats; `needed` must be NULL or writable.
@@ -703,8 +704,25 @@ enum PfStatus pf_world_get_densities(const struct PfWorld *world,
                                      size_t *needed);
 
 /**
+ * Copies the fluid particles' ids into `out` in ascending order, the order of every other
+ * per-particle read. Ids are given from 0 in the order particles are added and never
+ * reused, so a world without removals has the ids 0..n−1. `capacity` is the length of `out`
+ * in ids; fluid count are needed and written. `*needed` (when `needed` is not NULL)
+ * receives that number on success and on `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out`
+ * is untouched. `out` may be NULL only with capacity 0, to query the size. The world is not
+ * changed.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity` writable `uint64_t`s; `needed` must be NULL or writable.
+ */
+enum PfStatus pf_world_get_ids(const struct PfWorld *world,
+                               uint64_t *out,
+                               size_t capacity,
+                               size_t *needed);
+
+/**
  * Writes the hex SHA-256 of the fluid positions' exact (double precision) bit patterns, in
- * the order the particles were added, as a NUL-terminated string of 64 hex digits into
+ * ascending id order, as a NUL-terminated string of 64 hex digits into
  * `out` (capacity in bytes, at least 65). Equal strings mean bitwise equal positions, e.g.
  * between the C API and the Rust API or between runs. `*needed` (when not NULL) receives 65;
  * a short buffer gives `PF_ERROR_BUFFER_TOO_SMALL` and is left untouched.

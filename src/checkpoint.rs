@@ -6,26 +6,29 @@
 //! masses) from the scene, so a body's mesh file must still be readable, and their poses,
 //! velocities and loads from the state.
 //!
-//! Layout: the magic `PFCHECK2`; the length (u64, little-endian) of a JSON header, the
-//! header (the scene with the world's parameters, time, step count, next Δt, containers,
-//! grid, counts, the run's end, the online ρ_c estimate, the bodies' poses, velocities and
-//! loads); the fluid positions, velocities and densities as f64 triples/values, the particle
-//! ids as u32, the static boundary positions as f64 triples and their owners as u32 (all
-//! little-endian); and a SHA-256 digest of everything before it, so that a damaged or
-//! truncated file is refused.
+//! Layout: the magic `PFCHECK3`; the length (u64, little-endian) of a JSON header, the
+//! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
+//! containers, grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
+//! velocities and loads, the next particle id, the removed count, sinks, domain and
+//! emitters); the fluid positions, velocities and densities as f64 triples/values, the
+//! particle ids as u64, the static boundary positions as f64 triples and their owners as
+//! u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged
+//! or truncated file is refused.
 
-use crate::body::{BodyState, Pose, Velocity};
-use crate::boundary::Aabb;
+mod header;
+
 use crate::scene::Scene;
-use crate::solver::OnlineRho;
-use crate::{Error, GridParts, Vec3, World, WorldState};
+use crate::{Error, Vec3, World, WorldState};
+use header::{Header, SavedBody, SavedEmitter, aabb, saved_box};
 use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK2";
-/// The magic of the format before bodies, named in the error that refuses it.
+const MAGIC: &[u8; 8] = b"PFCHECK3";
+/// The magics of earlier formats, named in the errors that refuse them: before bodies, and
+/// before particle ids, sinks and emitters.
 const MAGIC_V1: &[u8; 8] = b"PFCHECK1";
+const MAGIC_V2: &[u8; 8] = b"PFCHECK2";
 const DIGEST_LEN: usize = 32;
 
 /// Where the interrupted run was going to stop.
@@ -49,73 +52,6 @@ pub struct Checkpoint {
     pub run_end: Option<RunEnd>,
 }
 
-/// The JSON header.
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Header {
-    scene: String,
-    time: f64,
-    steps: u64,
-    next_dt: f64,
-    containers: Vec<[[f64; 3]; 2]>,
-    grid: Option<GridParts>,
-    grid_capped: bool,
-    boundary_dirty: bool,
-    fluid_count: usize,
-    boundary_count: usize,
-    run_end: Option<RunEnd>,
-    chebyshev: OnlineRho,
-    bodies: Vec<SavedBody>,
-}
-
-/// A body's changing state in the header, every number exact (serde_json round-trips f64).
-#[derive(Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SavedBody {
-    /// Position (m) and quaternion [w, x, y, z].
-    pose: ([f64; 3], [f64; 4]),
-    /// Linear (m/s) and angular (rad/s) velocity.
-    velocity: [[f64; 3]; 2],
-    target: Option<([f64; 3], [f64; 4])>,
-    /// Force (N) and torque (N·m).
-    load: [[f64; 3]; 2],
-}
-
-impl SavedBody {
-    fn of(b: &BodyState) -> Self {
-        let pose = |p: &Pose| (p.position.into(), p.wxyz());
-        Self {
-            pose: pose(&b.pose),
-            velocity: [b.velocity.linear.into(), b.velocity.angular.into()],
-            target: b.target.as_ref().map(pose),
-            load: [b.force.into(), b.torque.into()],
-        }
-    }
-
-    /// The state, or an error naming what is not a valid pose.
-    fn state(&self) -> Result<BodyState, Error> {
-        let pose = |(x, q): &([f64; 3], [f64; 4])| {
-            // Stored quaternions are unit to round-off; keep them exactly as saved.
-            Pose::from_parts(Vec3::from(*x), *q).map(|_| Pose {
-                position: Vec3::from(*x),
-                rotation: crate::body::Rotation::new_unchecked(nalgebra::Quaternion::new(
-                    q[0], q[1], q[2], q[3],
-                )),
-            })
-        };
-        Ok(BodyState {
-            pose: pose(&self.pose)?,
-            velocity: Velocity {
-                linear: Vec3::from(self.velocity[0]),
-                angular: Vec3::from(self.velocity[1]),
-            },
-            target: self.target.as_ref().map(pose).transpose()?,
-            force: Vec3::from(self.load[0]),
-            torque: Vec3::from(self.load[1]),
-        })
-    }
-}
-
 /// Writes a checkpoint of `world`, which was built from `scene`, to `path` (through a
 /// temporary file renamed into place, so that an interrupted write never leaves a partial
 /// checkpoint under that name). `run_end` records where the run was going to stop.
@@ -133,11 +69,7 @@ pub fn write_checkpoint(
         time: state.time,
         steps: state.steps,
         next_dt: state.next_dt,
-        containers: state
-            .containers
-            .iter()
-            .map(|c| [c.min.into(), c.max.into()])
-            .collect(),
+        containers: state.containers.iter().map(saved_box).collect(),
         grid: state.grid,
         grid_capped: state.grid_capped,
         boundary_dirty: !state.boundary_sorted,
@@ -146,12 +78,17 @@ pub fn write_checkpoint(
         run_end,
         chebyshev: state.online_rho,
         bodies: state.bodies.iter().map(SavedBody::of).collect(),
+        next_id: state.next_id,
+        removed_count: state.removed_count,
+        sinks: state.sinks.iter().map(saved_box).collect(),
+        domain: state.domain.as_ref().map(saved_box),
+        emitters: state.emitters.iter().map(SavedEmitter::of).collect(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
     let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 60 + f.boundary_positions.len() * 28,
+        64 + json.len() + f.positions.len() * 64 + f.boundary_positions.len() * 28,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
@@ -205,6 +142,12 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
             "is a checkpoint of an earlier version without bodies, which this version cannot resume",
         ));
     }
+    if bytes.starts_with(MAGIC_V2) {
+        return Err(bad(
+            "is a checkpoint of an earlier version without stable particle ids, sinks and \
+             emitters, which this version cannot resume",
+        ));
+    }
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
@@ -231,7 +174,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
     let (n, m) = (header.fluid_count, header.boundary_count);
     let expected = n
-        .checked_mul(3 * 8 * 2 + 8 + 4)
+        .checked_mul(3 * 8 * 2 + 8 + 8)
         .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
@@ -249,7 +192,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let positions = data.vec3s(n);
     let velocities = data.vec3s(n);
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
-    let ids: Vec<u32> = (0..n).map(|_| u32::from_le_bytes(data.take())).collect();
+    let ids: Vec<u64> = (0..n).map(|_| u64::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
     let owners: Vec<u32> = (0..m).map(|_| u32::from_le_bytes(data.take())).collect();
     let bodies = header
@@ -266,18 +209,16 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         velocities,
         densities,
         ids,
+        next_id: header.next_id,
+        removed_count: header.removed_count,
         boundary_positions: boundary,
         boundary_owners: owners,
         bodies,
         boundary_sorted: !header.boundary_dirty,
-        containers: header
-            .containers
-            .iter()
-            .map(|[min, max]| Aabb {
-                min: Vec3::from(*min),
-                max: Vec3::from(*max),
-            })
-            .collect(),
+        containers: header.containers.iter().map(aabb).collect(),
+        sinks: header.sinks.iter().map(aabb).collect(),
+        domain: header.domain.as_ref().map(aabb),
+        emitters: header.emitters.iter().map(SavedEmitter::state).collect(),
         grid: header.grid,
         grid_capped: header.grid_capped,
         online_rho: header.chebyshev,

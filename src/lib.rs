@@ -18,6 +18,7 @@ pub mod body;
 pub mod boundary;
 pub mod checkpoint;
 pub mod constraint;
+pub mod emitter;
 mod error;
 pub mod ffi;
 mod fluid;
@@ -36,9 +37,10 @@ pub mod stats;
 mod step;
 mod world;
 
+pub use emitter::{Emitter, EmitterShape, EmitterSpec, EmitterState};
 pub use error::Error;
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
-pub use world::{BodyId, GridParts, World, WorldState};
+pub use world::{BodyId, EmitterId, GridParts, SinkId, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).
 pub type Vec3 = nalgebra::Vector3<f64>;

@@ -1,7 +1,9 @@
 //! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, before
-//! the first step, and with rigid bodies), and refused damaged, truncated and foreign files.
+//! the first step, with rigid bodies, and with emitters, sinks and removed particles), and
+//! refused damaged, truncated, foreign and earlier-format files.
 
 use super::*;
+use crate::body::BodyState;
 
 fn temp(name: &str) -> std::path::PathBuf {
     std::env::temp_dir().join(format!("projfluid-ckpt-{}-{name}", std::process::id()))
@@ -116,6 +118,71 @@ fn damaged_truncated_and_foreign_files_are_refused() {
     std::fs::remove_file(&path).unwrap();
     let msg = read_checkpoint(&path, None).err().unwrap().to_string();
     assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
+}
+
+/// A run with an emitter, a sink, a domain and removed particles resumes bit for bit: ids,
+/// the removed count, the emitter's progress and the boxes are in the checkpoint.
+#[test]
+fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
+    use crate::{EmitterShape, EmitterSpec};
+    let scene = small_scene();
+    let build = || {
+        let mut world = scene.build_world().unwrap();
+        let spec = EmitterSpec {
+            shape: EmitterShape::Disc { radius: 0.08 },
+            position: Vec3::new(0.15, 0.7, 0.3),
+            direction: Vec3::new(0.3, -1.0, 0.0),
+            speed: 1.2,
+            end_time: Some(0.5),
+        };
+        world.add_emitter(spec).unwrap();
+        let sink = crate::boundary::Aabb {
+            min: Vec3::new(0.0, 0.0, 0.0),
+            max: Vec3::new(0.15, 0.2, 0.65),
+        };
+        world.add_sink(sink).unwrap();
+        let mut domain = world.containers()[0];
+        domain.max.x = 0.28;
+        world.set_domain(Some(domain)).unwrap();
+        world
+    };
+    let mut reference = build();
+    let mut interrupted = build();
+    for _ in 0..20 {
+        reference.step().unwrap();
+        interrupted.step().unwrap();
+    }
+    assert!(reference.removed_count() > 0 && reference.emitted_count() > 0);
+    let path = temp("emitters.pfck");
+    write_checkpoint(&path, &scene, &interrupted, None).unwrap();
+    drop(interrupted);
+    let mut resumed = read_checkpoint(&path, Some(1)).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.export_state(), reference.export_state());
+    for _ in 0..20 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.ids(), reference.ids());
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_eq!(resumed.export_state(), reference.export_state());
+}
+
+/// A checkpoint of the format before stable ids is refused with a message saying so.
+#[test]
+fn checkpoints_of_earlier_formats_are_refused() {
+    let path = temp("v2.pfck");
+    for (magic, words) in [
+        (MAGIC_V2, "stable particle ids"),
+        (MAGIC_V1, "without bodies"),
+    ] {
+        let mut bytes = magic.to_vec();
+        bytes.extend_from_slice(&[0; 64]);
+        std::fs::write(&path, bytes).unwrap();
+        let message = read_checkpoint(&path, None).err().unwrap().to_string();
+        assert!(message.contains(words), "{message}");
+    }
+    std::fs::remove_file(&path).unwrap();
 }
 
 /// `small_scene` with a scripted kinematic paddle beyond the water, a dynamic box above it

@@ -10,8 +10,9 @@
 //!   (`PF_ERROR_PANIC`) and records the message; its pointer arguments are reached only
 //!   through `checked::Args`, which checks them (`PF_ERROR_NULL_POINTER`, misalignment).
 //! - Arrays of 3-vectors are flat `x, y, z, x, y, z, …` `float` arrays in metres (positions)
-//!   or m/s (velocities). Particles are reported in the order they were added. Rigid bodies
-//!   (`body`) take and report `double` vectors and poses, and are addressed by their id.
+//!   or m/s (velocities). Particles are reported in ascending id order, the order they were
+//!   added (see `pf_world_get_ids`). Rigid bodies (`body`) take and report `double` vectors
+//!   and poses, and are addressed by their id.
 //! - Thread safety: one world must not be used from two threads at once (a call that finds
 //!   the world busy returns `PF_ERROR_BUSY`); distinct worlds may be used in parallel.
 

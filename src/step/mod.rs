@@ -48,7 +48,7 @@ pub(crate) struct StepBuffers {
     /// The projection weight w_j of every fluid particle.
     weights: Vec<f64>,
     system: DiagonalSystem,
-    scratch_ids: Vec<u32>,
+    scratch_ids: Vec<u64>,
     /// δ_k of every outer iteration of the last step (m).
     pub(crate) displacements: Vec<f64>,
     /// The fluid's load on each body and, last, on the walls.
@@ -72,6 +72,9 @@ pub(crate) struct StepContext<'a> {
     pub wall_load: &'a mut Load,
     /// Simulated time at the start of the step (s).
     pub time: f64,
+    /// The fastest emitter still emitting after the step (m/s; 0 without any), which the
+    /// CFL rule counts like a fluid particle (docs/method.md §12.2).
+    pub inflow_speed: f64,
 }
 
 /// Advances the fluid by one step of `dt` seconds (positive, finite, checked by the
@@ -92,6 +95,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         bodies,
         wall_load,
         time,
+        inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
     for body in bodies.iter_mut() {
@@ -154,12 +158,52 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
             &mut timings,
         )
     });
-    let body_speed = bodies
+    // The fastest body particle or inflow (m/s).
+    let speed = bodies
         .iter()
         .map(|b| b.max_particle_speed())
-        .fold(0.0, f64::max);
-    let next_dt =
-        pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, body_speed));
+        .fold(inflow_speed, f64::max);
+    let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, speed));
+    (stats, next_dt)
+}
+
+/// A step of `dt` seconds without fluid particles (all removed, the emitters not yet due,
+/// docs/method.md §12.3): the bodies move on without loads, and the statistics are zero
+/// apart from Δt. Returns them with the size of the next step (s).
+pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
+    let StepContext {
+        params,
+        pool,
+        bodies,
+        wall_load,
+        time,
+        inflow_speed,
+        ..
+    } = ctx;
+    let gravity = Vec3::from(params.gravity);
+    for body in bodies.iter_mut() {
+        body.advance_pose(dt, time + dt);
+        body.force = Vec3::zeros();
+        body.torque = Vec3::zeros();
+        body.accelerate(dt, gravity);
+    }
+    *wall_load = Load::default();
+    let speed = bodies
+        .iter()
+        .map(|b| b.max_particle_speed())
+        .fold(inflow_speed, f64::max);
+    let stats = StepStats {
+        dt,
+        outer_iterations: 0,
+        inner_iterations: 0,
+        hit_max_iterations: false,
+        rho: 0.0,
+        last_displacement: 0.0,
+        density_error_avg: 0.0,
+        density_error_max: 0.0,
+        timings: StepTimings::default(),
+    };
+    let next_dt = pool.install(|| next_step_size(params, &[], gravity, dt, speed));
     (stats, next_dt)
 }
 
@@ -177,10 +221,10 @@ fn moving_particles(bodies: &[Body]) -> impl Iterator<Item = (Vec3, f64, u32)> +
         })
 }
 
-/// The CFL rule (docs/method.md §8, §11): Δt = λ·0.4·2r / v_max, clamped to
+/// The CFL rule (docs/method.md §8, §11, §12.2): Δt = λ·0.4·2r / v_max, clamped to
 /// [Δt_min, Δt_max] (s), where v_max is the larger of max|v + Δt g| over the fluid and
-/// `body_speed`, the fastest body particle (m/s), so that no body moves more than a fraction
-/// of a particle spacing per step.
+/// `body_speed`, the fastest body particle or emitter (m/s), so that no body moves more than
+/// a fraction of a particle spacing per step and no inflow arrives too fast.
 fn next_step_size(
     params: &Params,
     velocities: &[Vec3],

@@ -13,7 +13,8 @@ const MAX_MESH_SAMPLES: f64 = 50e6;
 
 impl World {
     /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
-    /// Rejects non-finite values and length mismatches without changing the world.
+    /// They get the next ids in the order given (see [`World::ids`]). Rejects non-finite
+    /// values and length mismatches without changing the world.
     pub fn add_fluid_particles(
         &mut self,
         positions: &[Vec3],
@@ -30,31 +31,26 @@ impl World {
             }
             check_finite("velocities", v)?;
         }
-        let first = self.fluid.positions.len();
-        if first + positions.len() > u32::MAX as usize / 64 {
+        if self.fluid.len() + positions.len() > MAX_PARTICLES {
             return Err(Error::invalid(
                 "positions",
                 positions.len(),
                 "would exceed the particle limit",
             ));
         }
-        self.fluid.positions.extend_from_slice(positions);
         match velocities {
-            Some(v) => self.fluid.velocities.extend_from_slice(v),
-            None => self
-                .fluid
-                .velocities
-                .resize(first + positions.len(), Vec3::zeros()),
+            Some(v) => self.fluid.push(positions, v.iter().copied()),
+            None => self.fluid.push(
+                positions,
+                std::iter::repeat_n(Vec3::zeros(), positions.len()),
+            ),
         }
-        self.fluid.densities.resize(first + positions.len(), 0.0);
-        self.fluid
-            .ids
-            .extend((first..first + positions.len()).map(|i| i as u32));
         Ok(())
     }
 
     /// Adds a cubic lattice of fluid particles with spacing 2r: centres at
     /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with `velocity`.
+    /// They get the next ids with i running fastest, then j, then k.
     pub fn add_fluid_block(
         &mut self,
         start: Vec3,
@@ -63,7 +59,7 @@ impl World {
     ) -> Result<(), Error> {
         let total = count.iter().try_fold(1usize, |acc, &c| acc.checked_mul(c));
         match total {
-            Some(n) if n > 0 && n <= u32::MAX as usize / 64 => {}
+            Some(n) if n > 0 && n <= MAX_PARTICLES => {}
             _ => {
                 return Err(Error::invalid(
                     "count",
@@ -147,7 +143,8 @@ impl World {
         f.positions.try_reserve(additional)?;
         f.velocities.try_reserve(additional)?;
         f.densities.try_reserve(additional)?;
-        f.ids.try_reserve(additional)
+        f.ids.try_reserve(additional)?;
+        f.ascending.try_reserve(additional)
     }
 
     /// Reserves room for `additional` more boundary particles (see [`World::try_reserve_fluid`]).

@@ -1,23 +1,29 @@
 //! The world: fluid particles, static boundary particles, parameters, the state of time
 //! stepping and the world's own thread pool. The CLI and the C API are thin shells over it.
 //! Its methods are grouped by what they do: [`fill`] adds particles, containers and meshes,
-//! [`read`] reports particles and measures, [`stepping`] advances time, [`state`] exports
-//! and imports the exact state.
+//! [`emitters`] and [`sinks`] add and remove fluid as the run goes, [`read`] reports
+//! particles and measures, [`stepping`] advances time, [`state`] exports and imports the
+//! exact state.
 
 mod bodies;
+mod emitters;
 mod fill;
 mod read;
+mod sinks;
 mod state;
 mod stepping;
 #[cfg(test)]
 mod tests;
 
 pub use bodies::BodyId;
+pub use emitters::EmitterId;
+pub use sinks::SinkId;
 pub use state::{GridParts, WorldState};
 
 use crate::body::Body;
 use crate::boundary::{Aabb, Boundary};
 use crate::constraint::DensityConstraint;
+use crate::emitter::Emitter;
 use crate::fluid::Fluid;
 use crate::forces::{self, NonPressureForce};
 use crate::kernel::CubicKernel;
@@ -36,6 +42,12 @@ pub struct World {
     pub(crate) boundary: Boundary,
     /// Container boxes; fluid outside all of them counts as escaped.
     pub(crate) containers: Vec<Aabb>,
+    /// Sink boxes: fluid in them at the end of a step is removed.
+    pub(crate) sinks: Vec<Aabb>,
+    /// Fluid outside the domain at the end of a step is removed.
+    pub(crate) domain: Option<Aabb>,
+    /// Emitters, in the order they were added.
+    pub(crate) emitters: Vec<Emitter>,
     pub(crate) grid: SearchGrid,
     /// Rigid bodies, in the order they were added.
     pub(crate) bodies: Vec<Body>,
@@ -85,6 +97,9 @@ impl World {
             fluid: Fluid::default(),
             boundary: Boundary::default(),
             containers: Vec::new(),
+            sinks: Vec::new(),
+            domain: None,
+            emitters: Vec::new(),
             grid: SearchGrid::default(),
             bodies: Vec::new(),
             wall_load: Load::default(),

@@ -1,32 +1,41 @@
-//! Reading a world: particles in the order they were added, counts, energies, escapes and
-//! a digest of the positions, and copies into caller buffers for embedders.
+//! Reading a world: particles in ascending id order (the order they were added, removed
+//! particles skipped; docs/method.md §12.1), counts, energies, escapes and a digest of the
+//! positions, and copies into caller buffers for embedders.
 
 use super::{World, check_finite};
 use crate::{Error, Vec3, reduce};
 
 impl World {
-    /// Copies a per-particle quantity into `out` in the order the particles were added.
+    /// Copies a per-particle quantity into `out` in ascending id order.
     fn gather_by_id<T: Copy>(&self, values: &[T], out: &mut [T]) {
         for (v, &id) in values.iter().zip(&self.fluid.ids) {
-            out[id as usize] = *v;
+            out[self.fluid.rank(id)] = *v;
         }
     }
 
-    /// Fluid positions (m) in the order they were added.
+    /// The fluid particles' ids in ascending order, the order of every per-particle read
+    /// ([`World::positions`] and the others): the order the particles were added, with the
+    /// removed ones skipped. Ids are given in the order particles are added, from 0, and
+    /// never reused; without removals they are 0..[`World::fluid_count`].
+    pub fn ids(&self) -> Vec<u64> {
+        self.fluid.ascending.clone()
+    }
+
+    /// Fluid positions (m) in ascending id order (see [`World::ids`]).
     pub fn positions(&self) -> Vec<Vec3> {
         let mut out = vec![Vec3::zeros(); self.fluid_count()];
         self.gather_by_id(&self.fluid.positions, &mut out);
         out
     }
 
-    /// Fluid velocities (m/s) in the order the particles were added.
+    /// Fluid velocities (m/s) in ascending id order (see [`World::ids`]).
     pub fn velocities(&self) -> Vec<Vec3> {
         let mut out = vec![Vec3::zeros(); self.fluid_count()];
         self.gather_by_id(&self.fluid.velocities, &mut out);
         out
     }
 
-    /// Replaces every fluid velocity (m/s), given in the order the particles were added.
+    /// Replaces every fluid velocity (m/s), given in ascending id order (see [`World::ids`]).
     /// Rejects a length mismatch or a non-finite value without changing the world.
     pub fn set_velocities(&mut self, velocities: &[Vec3]) -> Result<(), Error> {
         if velocities.len() != self.fluid_count() {
@@ -41,14 +50,14 @@ impl World {
         }
         check_finite("velocities", velocities)?;
         let fluid = &mut self.fluid;
-        for (v, &id) in fluid.velocities.iter_mut().zip(&fluid.ids) {
-            *v = velocities[id as usize];
+        for slot in 0..fluid.len() {
+            fluid.velocities[slot] = velocities[fluid.rank(fluid.ids[slot])];
         }
         Ok(())
     }
 
-    /// Fluid densities (kg/m³) after the last step, in the order the particles were added
-    /// (zero before the first step).
+    /// Fluid densities (kg/m³) after the last step, in ascending id order (see
+    /// [`World::ids`]; zero before a particle's first step).
     pub fn densities(&self) -> Vec<f64> {
         let mut out = vec![0.0; self.fluid_count()];
         self.gather_by_id(&self.fluid.densities, &mut out);
@@ -120,16 +129,15 @@ impl World {
             .count()
     }
 
-    /// A hex SHA-256 digest of the positions' bit patterns in the order the particles were
-    /// added; equal digests mean bitwise identical positions.
+    /// A hex SHA-256 digest of the positions' bit patterns in ascending id order (see
+    /// [`World::ids`]); equal digests mean bitwise identical positions.
     pub fn positions_hash(&self) -> String {
         use sha2::{Digest, Sha256};
         let mut hasher = Sha256::new();
-        // The particles' slots in the order they were added (a quarter of a copy of the
-        // positions).
+        // The particles' slots in ascending id order (a quarter of a copy of the positions).
         let mut slots = vec![0u32; self.fluid_count()];
         for (slot, &id) in self.fluid.ids.iter().enumerate() {
-            slots[id as usize] = slot as u32;
+            slots[self.fluid.rank(id)] = slot as u32;
         }
         for &slot in &slots {
             for c in self.fluid.positions[slot as usize].iter() {
@@ -147,7 +155,7 @@ impl World {
 /// Copies into caller buffers, without allocating, for embedders such as the C API.
 impl World {
     /// Writes fluid positions (m) as x, y, z triples of `f32` into `out[..3·fluid_count()]`, in
-    /// the order the particles were added, without allocating. Returns the number of floats
+    /// ascending id order (see [`World::ids`]), without allocating. Returns the number of floats
     /// needed as the error, leaving `out` untouched, when `out` is too short.
     pub fn write_positions_f32(&self, out: &mut [f32]) -> Result<(), usize> {
         self.write_vectors_f32(&self.fluid.positions, out)
@@ -159,13 +167,13 @@ impl World {
     }
 
     /// Writes fluid densities (kg/m³, zero before the first step) into
-    /// `out[..fluid_count()]` in the order the particles were added; errs with the number of
-    /// floats needed, leaving `out` untouched, when `out` is too short.
+    /// `out[..fluid_count()]` in ascending id order; errs with the number of floats needed,
+    /// leaving `out` untouched, when `out` is too short.
     pub fn write_densities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
         let n = self.fluid_count();
         let out = out.get_mut(..n).ok_or(n)?;
         for (&rho, &id) in self.fluid.densities.iter().zip(&self.fluid.ids) {
-            out[id as usize] = rho as f32;
+            out[self.fluid.rank(id)] = rho as f32;
         }
         Ok(())
     }
@@ -174,9 +182,19 @@ impl World {
         let n = 3 * self.fluid_count();
         let out = out.get_mut(..n).ok_or(n)?;
         for (v, &id) in values.iter().zip(&self.fluid.ids) {
-            let i = 3 * id as usize;
+            let i = 3 * self.fluid.rank(id);
             out[i..i + 3].copy_from_slice(&[v.x as f32, v.y as f32, v.z as f32]);
         }
+        Ok(())
+    }
+
+    /// Writes the fluid particles' ids into `out[..fluid_count()]` in ascending order (see
+    /// [`World::ids`]), without allocating; errs with the number of ids needed, leaving
+    /// `out` untouched, when `out` is too short.
+    pub fn write_ids(&self, out: &mut [u64]) -> Result<(), usize> {
+        let n = self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        out.copy_from_slice(&self.fluid.ascending);
         Ok(())
     }
 }

@@ -10,6 +10,7 @@
 use super::World;
 use crate::body::BodyState;
 use crate::boundary::{Aabb, WALLS};
+use crate::emitter::{Emitter, EmitterState};
 use crate::neighbors::UniformGrid;
 use crate::solver::OnlineRho;
 use crate::step::SearchGrid;
@@ -17,7 +18,7 @@ use crate::{Error, Vec3};
 use serde::{Deserialize, Serialize};
 
 /// A world's complete state apart from its parameters. Per-particle arrays are in the
-/// world's storage order; `ids` maps each stored particle to the order it was added in.
+/// world's storage order; `ids` gives each stored particle's id.
 #[derive(Clone, Debug, PartialEq)]
 pub struct WorldState {
     /// Simulated time (s).
@@ -32,8 +33,12 @@ pub struct WorldState {
     pub velocities: Vec<Vec3>,
     /// Fluid densities after the last step (kg/m³).
     pub densities: Vec<f64>,
-    /// The index each stored fluid particle was added with: a permutation of 0..n.
-    pub ids: Vec<u32>,
+    /// Each stored fluid particle's id (docs/method.md §12.1): unique, below `next_id`.
+    pub ids: Vec<u64>,
+    /// The id the next added particle gets: the number of particles ever added.
+    pub next_id: u64,
+    /// Particles removed so far: `next_id` less the number of particles.
+    pub removed_count: u64,
     /// Static boundary particle positions (m): walls, obstacles and static bodies (moving
     /// bodies' particles follow from their poses).
     pub boundary_positions: Vec<Vec3>,
@@ -46,6 +51,12 @@ pub struct WorldState {
     pub boundary_sorted: bool,
     /// Container boxes (m).
     pub containers: Vec<Aabb>,
+    /// Sink boxes (m).
+    pub sinks: Vec<Aabb>,
+    /// The domain (m), if one is set.
+    pub domain: Option<Aabb>,
+    /// Every emitter's spec and progress, in the order they were added.
+    pub emitters: Vec<EmitterState>,
     /// The neighbour grid, once a step built one.
     pub grid: Option<GridParts>,
     /// The grid reached its cell limit and no longer grows.
@@ -79,11 +90,16 @@ impl World {
             velocities: fluid.velocities.clone(),
             densities: fluid.densities.clone(),
             ids: fluid.ids.clone(),
+            next_id: fluid.next_id,
+            removed_count: fluid.removed,
             boundary_positions,
             boundary_owners,
             bodies: self.bodies.iter().map(|b| b.state()).collect(),
             boundary_sorted: !self.boundary.dirty,
             containers: self.containers.clone(),
+            sinks: self.sinks.clone(),
+            domain: self.domain,
+            emitters: self.emitters.iter().map(|e| *e.state()).collect(),
             grid: self.grid.grid.as_ref().map(|g| {
                 let (origin, cell_size, dims) = g.parts();
                 GridParts {
@@ -97,10 +113,11 @@ impl World {
         }
     }
 
-    /// Replaces the world's particles, containers, grid and time with `state`, as
-    /// [`World::export_state`] returned it; the world's parameters stay. Rejects a state
-    /// whose arrays differ in length, whose values are not finite, whose ids are not a
-    /// permutation or whose grid is invalid, changing nothing.
+    /// Replaces the world's particles, containers, sinks, domain, emitters, grid and time
+    /// with `state`, as [`World::export_state`] returned it; the world's parameters stay.
+    /// Rejects a state whose arrays differ in length, whose values are not finite, whose ids
+    /// repeat or reach `next_id`, whose counts disagree, whose boxes or emitters are invalid
+    /// or whose grid is invalid, changing nothing.
     pub fn import_state(&mut self, state: WorldState) -> Result<(), Error> {
         let n = state.positions.len();
         for (name, len) in [
@@ -119,19 +136,22 @@ impl World {
         super::check_finite("state.positions", &state.positions)?;
         super::check_finite("state.velocities", &state.velocities)?;
         super::check_finite("state.boundary_positions", &state.boundary_positions)?;
-        let mut seen = vec![false; n];
-        for &id in &state.ids {
-            match seen.get_mut(id as usize) {
-                Some(s) if !*s => *s = true,
-                _ => {
-                    return Err(Error::invalid(
-                        "state.ids",
-                        id,
-                        "must be a permutation of 0..n",
-                    ));
-                }
-            }
+        let ascending = checked_ids(&state)?;
+        for (k, sink) in state.sinks.iter().enumerate() {
+            super::sinks::check_box(&format!("state.sinks[{k}]"), sink)?;
         }
+        if let Some(domain) = &state.domain {
+            super::sinks::check_box("state.domain", domain)?;
+        }
+        let emitters = state
+            .emitters
+            .iter()
+            .enumerate()
+            .map(|(k, e)| {
+                Emitter::new(*e, self.params.spacing())
+                    .map_err(|e| renamed(e, "emitter.", &format!("state.emitters[{k}].")))
+            })
+            .collect::<Result<Vec<_>, _>>()?;
         if state.boundary_owners.len() != state.boundary_positions.len() {
             return Err(Error::invalid(
                 "state.boundary_owners",
@@ -190,6 +210,9 @@ impl World {
         fluid.velocities = state.velocities;
         fluid.densities = state.densities;
         fluid.ids = state.ids;
+        fluid.ascending = ascending;
+        fluid.next_id = state.next_id;
+        fluid.removed = state.removed_count;
         self.boundary.positions = state.boundary_positions;
         self.boundary.owner = state.boundary_owners;
         self.boundary.psi.clear();
@@ -197,6 +220,9 @@ impl World {
             body.set_state(b);
         }
         self.containers = state.containers;
+        self.sinks = state.sinks;
+        self.domain = state.domain;
+        self.emitters = emitters;
         self.time = state.time;
         self.steps = state.steps;
         self.next_dt = state.next_dt;
@@ -215,6 +241,46 @@ impl World {
         }
         self.last = None;
         Ok(())
+    }
+}
+
+/// The state's ids in ascending order, or an error when one repeats or is not below
+/// `next_id`, or when `next_id` is not the particle count plus `removed_count`.
+fn checked_ids(state: &WorldState) -> Result<Vec<u64>, Error> {
+    let mut ascending = state.ids.clone();
+    ascending.sort_unstable();
+    if let Some(pair) = ascending.windows(2).find(|p| p[0] == p[1]) {
+        return Err(Error::invalid("state.ids", pair[0], "must be unique"));
+    }
+    if let Some(&last) = ascending.last().filter(|&&id| id >= state.next_id) {
+        return Err(Error::invalid(
+            "state.ids",
+            last,
+            &format!("must be below state.next_id ({})", state.next_id),
+        ));
+    }
+    let n = state.ids.len() as u64;
+    if state.next_id.checked_sub(n) != Some(state.removed_count) {
+        return Err(Error::invalid(
+            "state.removed_count",
+            state.removed_count,
+            &format!(
+                "must be state.next_id ({}) less the particle count ({n})",
+                state.next_id
+            ),
+        ));
+    }
+    Ok(ascending)
+}
+
+/// `e` with the field's prefix `from` replaced by `to`, in its field and its message.
+fn renamed(e: Error, from: &str, to: &str) -> Error {
+    match e {
+        Error::InvalidArgument { field, message } => Error::InvalidArgument {
+            field: field.replacen(from, to, 1),
+            message: message.replacen(from, to, 1),
+        },
+        other => other,
     }
 }
 

@@ -1,10 +1,11 @@
 //! Advancing a world in time: one step, a duration, or a damped relaxation towards rest.
-//! The step itself is [`crate::step`]'s; this is where its size is checked and time kept.
+//! The step itself is [`crate::step`]'s; this is where its size is checked, time kept, and
+//! fluid emitted before it and removed after it (docs/method.md §12).
 
 use super::World;
 use crate::Error;
 use crate::stats::StepStats;
-use crate::step::{StepContext, take_step};
+use crate::step::{StepContext, idle_step, take_step};
 
 impl World {
     /// Takes one step with the CFL-limited step size.
@@ -14,6 +15,12 @@ impl World {
 
     /// Takes one step of `dt` seconds (positive, finite). The CFL rule still sets the size
     /// the following [`World::step`] will use.
+    ///
+    /// Before the step the emitters insert their due layers; after it the particles in a
+    /// sink or outside the domain are removed (the step's statistics, and the next Δt, are
+    /// those of the step before the removal). A world without fluid particles steps only if
+    /// it has emitters or had particles removed: time and bodies then move on and the
+    /// statistics are zero; otherwise stepping it is an error.
     pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
         if !(dt.is_finite() && dt > 0.0 && dt <= 1.0) {
             return Err(Error::invalid(
@@ -22,13 +29,16 @@ impl World {
                 "must be a positive finite number of seconds (at most 1)",
             ));
         }
-        if self.fluid_count() == 0 {
+        if self.fluid_count() == 0 && self.emitters.is_empty() && self.fluid.removed == 0 {
             return Err(Error::invalid(
                 "fluid particles",
                 0,
                 "must be present before stepping",
             ));
         }
+        self.emit()?;
+        let inflow_speed = self.inflow_speed(self.time + dt);
+        let idle = self.fluid_count() == 0;
         let World {
             params,
             constraint,
@@ -59,11 +69,18 @@ impl World {
             bodies,
             wall_load,
             time: *time,
+            inflow_speed,
         };
-        let (stats, next_dt) = take_step(context, dt);
+        let (stats, next_dt) = if idle {
+            idle_step(context, dt)
+        } else {
+            take_step(context, dt)
+        };
         self.next_dt = next_dt;
         self.time += dt;
         self.steps += 1;
+        self.advance_emitters(dt);
+        self.drain();
         Ok(self.last.insert(stats))
     }
 

@@ -84,6 +84,16 @@ int main(int argc, char **argv) {
     OK(pf_world_get_densities(world, rho, n, &needed));
     CHECK(needed == n && rho[0] == 0.0f);
 
+    /* Particle ids: 0..n-1 in the order the particles were added, the order of every read. */
+    uint64_t *ids = malloc(n * sizeof *ids);
+    CHECK(ids);
+    EXPECT(PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_ids(world, NULL, 0, &needed));
+    CHECK(needed == n);
+    EXPECT(PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_ids(world, ids, n - 1, NULL));
+    OK(pf_world_get_ids(world, ids, n, &needed));
+    CHECK(needed == n);
+    for (size_t i = 0; i < n; i++) CHECK(ids[i] == i);
+
     /* A fixed step, then CFL steps. */
     OK(pf_world_step(world, 0.002));
     for (int i = 1; i < steps; i++) OK(pf_world_step(world, 0.0));
@@ -127,6 +137,11 @@ int main(int argc, char **argv) {
     /* Gravity pulled the block down. */
     CHECK(vel[1] < 0.0f);
 
+    /* The steps sorted the particles; the ids still read back in order. */
+    memset(ids, 0xff, n * sizeof *ids);
+    OK(pf_world_get_ids(world, ids, n, NULL));
+    for (size_t i = 0; i < n; i++) CHECK(ids[i] == i);
+
     char hash[65];
     OK(pf_world_positions_hash(world, hash, sizeof hash, &needed));
     CHECK(needed == 65 && strlen(hash) == 64);
@@ -136,6 +151,7 @@ int main(int argc, char **argv) {
     free(pos);
     free(vel);
     free(rho);
+    free(ids);
     pf_world_destroy(world);
     pf_world_destroy(NULL);
     return 0;

@@ -1,5 +1,6 @@
 //! The functions that read a `PfWorld` without changing it: counts, time, parameters, the
-//! last step's statistics, positions, velocities, densities and the positions' hash.
+//! last step's statistics, positions, velocities, densities, particle ids and the positions'
+//! hash.
 
 use super::PfWorld;
 use crate::ffi::checked::Args;
@@ -176,11 +177,12 @@ fn get(
     })
 }
 
-/// Copies the fluid positions (m) into `out` as x, y, z floats per particle, in the order
-/// the particles were added. `capacity_floats` is the length of `out` in floats; 3·fluid
-/// count are needed and written. `*needed` (when `needed` is not NULL) receives that number
-/// on success and on `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out` is untouched. `out`
-/// may be NULL only with capacity 0, to query the size. The world is not changed.
+/// Copies the fluid positions (m) into `out` as x, y, z floats per particle, in ascending id
+/// order (the order the particles were added, removed ones skipped; see `pf_world_get_ids`).
+/// `capacity_floats` is the length of `out` in floats; 3·fluid count are needed and written.
+/// `*needed` (when `needed` is not NULL) receives that number on success and on
+/// `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out` is untouched. `out` may be NULL only with
+/// capacity 0, to query the size. The world is not changed.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity_floats` writable floats; `needed` must be NULL or writable.
@@ -229,7 +231,7 @@ pub unsafe extern "C" fn pf_world_get_velocities(
 }
 
 /// Copies the fluid densities (kg/m³, 0 before the first step) into `out`, one float per
-/// particle in the order the particles were added; otherwise like `pf_world_get_positions`.
+/// particle in ascending id order; otherwise like `pf_world_get_positions`.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity_floats` writable floats; `needed` must be NULL or writable.
@@ -253,8 +255,46 @@ pub unsafe extern "C" fn pf_world_get_densities(
     )
 }
 
+/// Copies the fluid particles' ids into `out` in ascending order, the order of every other
+/// per-particle read. Ids are given from 0 in the order particles are added and never
+/// reused, so a world without removals has the ids 0..n−1. `capacity` is the length of `out`
+/// in ids; fluid count are needed and written. `*needed` (when `needed` is not NULL)
+/// receives that number on success and on `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out`
+/// is untouched. `out` may be NULL only with capacity 0, to query the size. The world is not
+/// changed.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity` writable `uint64_t`s; `needed` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_get_ids(
+    world: *const PfWorld,
+    out: *mut u64,
+    capacity: usize,
+    needed: *mut usize,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_get_ids", || {
+        let world = args.world(world)?;
+        let want = world.fluid_count();
+        if !needed.is_null() {
+            args.write(needed, want, "needed")?;
+        }
+        if capacity < want {
+            return Err(Failure::new(
+                PfStatus::PF_ERROR_BUFFER_TOO_SMALL,
+                format!("the buffer holds {capacity} ids but {want} are needed"),
+            ));
+        }
+        let out = args.out_slice(out, capacity, "out")?;
+        world
+            .write_ids(out)
+            .map_err(|n| Failure::new(PfStatus::PF_ERROR_BUFFER_TOO_SMALL, format!("{n}")))
+    })
+}
+
 /// Writes the hex SHA-256 of the fluid positions' exact (double precision) bit patterns, in
-/// the order the particles were added, as a NUL-terminated string of 64 hex digits into
+/// ascending id order, as a NUL-terminated string of 64 hex digits into
 /// `out` (capacity in bytes, at least 65). Equal strings mean bitwise equal positions, e.g.
 /// between the C API and the Rust API or between runs. `*needed` (when not NULL) receives 65;
 /// a short buffer gives `PF_ERROR_BUFFER_TOO_SMALL` and is left untouched.

@@ -29,6 +29,24 @@ pub(crate) struct Boundary {
     pub dirty: bool,
     /// Whether the body of each owner index moves (its particles are placed every step).
     moving: Vec<bool>,
+    /// Buffers of the per-step sort while bodies move.
+    spare: Spare,
+}
+
+/// The sort order and the previous arrays of [`Boundary::place_moving`], kept for reuse.
+#[derive(Clone, Debug, Default)]
+struct Spare {
+    order: Vec<u32>,
+    positions: Vec<Vec3>,
+    psi: Vec<f64>,
+    owner: Vec<u32>,
+}
+
+/// Reorders `data` so that slot k holds the old `data[order[k]]`, through `spare`.
+fn permute<T: Copy>(order: &[u32], data: &mut Vec<T>, spare: &mut Vec<T>) {
+    spare.clear();
+    spare.extend(order.iter().map(|&i| data[i as usize]));
+    std::mem::swap(data, spare);
 }
 
 impl Boundary {
@@ -57,23 +75,27 @@ impl Boundary {
         owner != WALLS && self.moving.get(owner as usize).copied().unwrap_or(false)
     }
 
-    /// Removes the moving bodies' particles, keeping the static ones in their order.
+    /// Removes the moving bodies' particles, keeping the static ones in their order (in place;
+    /// ψ is compacted alongside when it is valid for every particle).
     pub fn drop_moving(&mut self) {
-        if !self.owner.iter().any(|&o| self.is_moving(o)) {
-            return;
+        let with_psi = self.psi.len() == self.positions.len();
+        let mut kept = 0;
+        for k in 0..self.positions.len() {
+            if self.is_moving(self.owner[k]) {
+                continue;
+            }
+            self.positions[kept] = self.positions[k];
+            self.owner[kept] = self.owner[k];
+            if with_psi {
+                self.psi[kept] = self.psi[k];
+            }
+            kept += 1;
         }
-        let keep: Vec<bool> = self.owner.iter().map(|&o| !self.is_moving(o)).collect();
-        let mut k = keep.iter();
-        self.positions
-            .retain(|_| *k.next().expect("one flag per particle"));
-        if self.psi.len() == keep.len() {
-            let mut k = keep.iter();
-            self.psi
-                .retain(|_| *k.next().expect("one flag per particle"));
+        self.positions.truncate(kept);
+        self.owner.truncate(kept);
+        if with_psi {
+            self.psi.truncate(kept);
         }
-        let mut k = keep.iter();
-        self.owner
-            .retain(|_| *k.next().expect("one flag per particle"));
     }
 
     /// Sorts the static particles into `grid`'s cells and computes their Akinci masses with
@@ -111,12 +133,13 @@ impl Boundary {
             self.psi.push(psi);
             self.owner.push(owner);
         }
-        let mut order = Vec::new();
-        grid.sort(&self.positions, &mut order, &mut self.table);
-        self.table.release_scratch();
-        self.positions = order.iter().map(|&i| self.positions[i as usize]).collect();
-        self.psi = order.iter().map(|&i| self.psi[i as usize]).collect();
-        self.owner = order.iter().map(|&i| self.owner[i as usize]).collect();
+        // The sort's order and the permuted copies live in reusable buffers: this runs every
+        // step while bodies move.
+        let order = &mut self.spare.order;
+        grid.sort(&self.positions, order, &mut self.table);
+        permute(order, &mut self.positions, &mut self.spare.positions);
+        permute(order, &mut self.psi, &mut self.spare.psi);
+        permute(order, &mut self.owner, &mut self.spare.owner);
         self.by_component.fill(&self.positions);
     }
 

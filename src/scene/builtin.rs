@@ -154,6 +154,9 @@ fn dam_break(
         obstacles: Vec::new(),
         bodies: Vec::new(),
         fluid_blocks: vec![block([0.05; 3], count)],
+        emitters: Vec::new(),
+        sinks: Vec::new(),
+        domain: None,
         duration,
         output: OutputSpec::default(),
     }

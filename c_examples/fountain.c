@@ -29,10 +29,11 @@ int main(int argc, char **argv) {
     PfWorld *world = NULL;
     check(pf_world_create(&params, &world), "pf_world_create");
 
-    /* The basin, its walls r/4 outside the nominal box, and a pool 0.2 m deep. */
+    /* The basin, its walls two layers thick (one lets the jet push a particle through the
+     * floor) r/4 outside the nominal box, and a pool 0.2 m deep. */
     const float lo[3] = {-0.00625f, -0.00625f, -0.00625f};
     const float hi[3] = {1.00625f, 1.20625f, 1.00625f};
-    check(pf_world_add_container_box(world, lo, hi, 1), "pf_world_add_container_box");
+    check(pf_world_add_container_box(world, lo, hi, 2), "pf_world_add_container_box");
     const float start[3] = {0.05f, 0.05f, 0.05f};
     const size_t count[3] = {19, 4, 19};
     check(pf_world_add_fluid_box(world, start, count, NULL), "pf_world_add_fluid_box");

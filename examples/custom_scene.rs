@@ -38,6 +38,9 @@ fn main() -> Result<(), projfluid::Error> {
                 velocity: [-1.0, 0.0, 0.0],
             },
         ],
+        emitters: Vec::new(),
+        sinks: Vec::new(),
+        domain: None,
         duration: 0.3,
         output: OutputSpec::default(),
     };

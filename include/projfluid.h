@@ -586,6 +586,136 @@ enum PfStatus pf_world_add_container_box(struct PfWorld *world,
                                          unsigned int layers);
 
 /**
+ * Adds an emitter with a disc-shaped opening of `radius` (m) centred on `position`
+ * (3 doubles, m), in the plane normal to `direction` (3 doubles, any non-zero length), and
+ * stores its index in `*out_id`. From the start of the next step it inserts fluid
+ * particles moving at `speed` (m/s) along `direction`: a layer on a square lattice of
+ * spacing 2r over the opening each time the layer before has travelled 2r (speed × area /
+ * (2r)³ particles per second), skipping lattice points closer than 0.9 · 2r to fluid.
+ * `end_time` (s) is the simulated time from which no more layers are emitted; a value ≤ 0
+ * or `INFINITY` means none (the emitter runs forever). Emitted particles get new ids; see
+ * `pf_world_emitted_count`.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world, position, direction or out_id NULL),
+ * `PF_ERROR_INVALID_ARGUMENT` (a non-finite position or direction, a zero direction, a
+ * speed that is not positive and finite, a NaN end_time, a radius that is not positive and
+ * finite or holds no lattice point — "zero area" — or far too many). On any error no
+ * emitter is added and `*out_id` is untouched. Thread safety: one thread at a time per
+ * world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `position` and `direction` must be NULL or point to 3 readable doubles; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_emitter_disc(struct PfWorld *world,
+                                        const double *position,
+                                        const double *direction,
+                                        double radius,
+                                        double speed,
+                                        double end_time,
+                                        size_t *out_id);
+
+/**
+ * Like `pf_world_add_emitter_disc`, with a rectangular opening of half-extents `half_a`
+ * and `half_b` (m) along the opening plane's first and second axes: the coordinate axis
+ * least aligned with `direction` projected into the plane, and `direction` × that (x and z
+ * for a direction −y, y and z for +x). Only whole lattice cells of side 2r count.
+ *
+ * Errors: as `pf_world_add_emitter_disc`, with `half_a` or `half_b` named.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `position` and `direction` must be NULL or point to 3 readable doubles; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_emitter_rect(struct PfWorld *world,
+                                        const double *position,
+                                        const double *direction,
+                                        double half_a,
+                                        double half_b,
+                                        double speed,
+                                        double end_time,
+                                        size_t *out_id);
+
+/**
+ * Adds a sink, the box from `min` to `max` (3 doubles each, m), and stores its index in
+ * `*out_id`: at the end of every step each fluid particle in it (faces included) is removed
+ * (see `pf_world_removed_count`).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world, min, max or out_id NULL),
+ * `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, or min > max along an axis). On any
+ * error no sink is added and `*out_id` is untouched. Thread safety: one thread at a time
+ * per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable doubles; `out_id` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_sink(struct PfWorld *world,
+                                const double *min,
+                                const double *max,
+                                size_t *out_id);
+
+/**
+ * Sets the domain to the box from `min` to `max` (3 doubles each, m), replacing any
+ * earlier one: at the end of every step each fluid particle outside it (faces count as
+ * inside), or with a non-finite position, is removed. A new world has no domain.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, or
+ * min > max along an axis); the domain is then unchanged. Thread safety: one thread at a
+ * time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable doubles.
+ */
+enum PfStatus pf_world_set_domain(struct PfWorld *world,
+                                  const double *min,
+                                  const double *max);
+
+/**
+ * Removes the domain, if any: no particle is removed for leaving it any more.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`.
+ */
+enum PfStatus pf_world_clear_domain(struct PfWorld *world);
+
+/**
+ * Removes the fluid particles whose ids are `ids[0..count]` (see `pf_world_get_ids`) now,
+ * between steps, and stores how many were removed (`count`) in `*removed`. The other
+ * particles keep their ids and order; removed ids are never given again. `ids` may be NULL
+ * when `count` is 0.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or removed NULL, or ids NULL with count > 0),
+ * `PF_ERROR_INVALID_ARGUMENT` (an id that is not that of a fluid particle of the world —
+ * never given, or removed already — or one listed twice; the id is named). On any error no
+ * particle is removed and `*removed` is untouched. Thread safety: one thread at a time per
+ * world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `ids` must be NULL or point to `count` readable `uint64_t`s; `removed` must be NULL or writable.
+ */
+enum PfStatus pf_world_remove_particles(struct PfWorld *world,
+                                        const uint64_t *ids,
+                                        size_t count,
+                                        size_t *removed);
+
+/**
+ * Stores in `*out` the number of fluid particles removed so far: by sinks, by the domain
+ * and by `pf_world_remove_particles`.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_removed_count(const struct PfWorld *world, uint64_t *out);
+
+/**
+ * Stores in `*out` the number of fluid particles inserted by emitters so far.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out);
+
+/**
  * Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
  * `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
  *

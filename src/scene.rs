@@ -12,6 +12,7 @@
 mod bodies;
 mod builtin;
 mod file;
+mod flow;
 pub mod obstacle;
 mod spec;
 #[cfg(test)]
@@ -20,12 +21,12 @@ mod validate;
 
 pub use bodies::{BodyShape, MotionSpec, SceneBody};
 pub use spec::{
-    ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
+    BoxSpec, ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
 };
 
 use crate::boundary::Aabb;
 use crate::params::Params;
-use crate::{Error, Vec3, World};
+use crate::{EmitterSpec, Error, Vec3, World};
 use std::path::Path;
 
 /// A complete simulation setup.
@@ -45,6 +46,13 @@ pub struct Scene {
     pub bodies: Vec<SceneBody>,
     /// Blocks of fluid (at least one).
     pub fluid_blocks: Vec<FluidBlock>,
+    /// Emitters inserting fluid from the start of the first step (may be empty). Emitter `i`
+    /// gets index `i`.
+    pub emitters: Vec<EmitterSpec>,
+    /// Sinks: boxes removing the fluid in them at the end of every step (may be empty).
+    pub sinks: Vec<BoxSpec>,
+    /// The domain: fluid outside it at the end of a step is removed (`None`: kept).
+    pub domain: Option<BoxSpec>,
     /// Simulated time to run (s).
     pub duration: f64,
     /// Frame output settings.
@@ -114,8 +122,9 @@ impl Scene {
     }
 
     /// Checks the whole scene: parameters (named by their JSON keys, e.g. `solver.rho`),
-    /// duration, output, containers, obstacles, bodies (e.g. `bodies[1].density`) and fluid
-    /// blocks (every particle centre inside a container).
+    /// duration, output, containers, obstacles, bodies (e.g. `bodies[1].density`), fluid
+    /// blocks (every particle centre inside a container), emitters (e.g. `emitters[0].speed`),
+    /// sinks and the domain.
     pub fn validate(&self) -> Result<(), Error> {
         validate::validate(self)
     }
@@ -127,9 +136,9 @@ impl Scene {
             .fold(0usize, |acc, b| acc.saturating_add(b.particle_count()))
     }
 
-    /// A world with the scene's parameters, containers, obstacles, bodies and fluid, ready to
-    /// step. Obstacle and body meshes are read (or generated) here; their errors start with
-    /// `obstacles[i]: ` or `bodies[i]: `.
+    /// A world with the scene's parameters, containers, obstacles, bodies, fluid, emitters,
+    /// sinks and domain, ready to step. Obstacle and body meshes are read (or generated)
+    /// here; their errors start with `obstacles[i]: ` or `bodies[i]: `.
     pub fn build_world(&self) -> Result<World, Error> {
         self.validate()?;
         let mut world = World::new(self.params.clone())?;
@@ -155,6 +164,7 @@ impl Scene {
                 .add_fluid_block(Vec3::from(b.start), b.count, Vec3::from(b.velocity))
                 .map_err(|e| prefixed(e, &format!("fluid_blocks[{i}]: ")))?;
         }
+        self.add_flow(&mut world)?;
         Ok(world)
     }
 

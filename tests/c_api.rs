@@ -278,6 +278,22 @@ fn c_bodies_move_push_fall_reject_misuse_and_match_the_rust_api() {
     }
 }
 
+/// Emitters, sinks, the domain and removal by id from C: the counts add up, and every
+/// misuse is rejected changing nothing.
+#[test]
+fn c_emitters_and_sinks_pour_drain_and_reject_misuse() {
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/emitters.c", link), &[]);
+        let last = out.lines().last().unwrap_or_default();
+        assert!(last.starts_with("emitters: ok"), "{link:?}: {out}");
+        let checked: usize = last
+            .split_whitespace()
+            .find_map(|w| w.parse().ok())
+            .expect("emitters prints the number of rejected calls");
+        assert!(checked >= 40, "only {checked} rejected calls were checked");
+    }
+}
+
 #[test]
 fn c_examples_build_and_run() {
     let out = run(&build("c_examples/minimal.c", Link::Static), &[]);
@@ -301,6 +317,25 @@ fn c_examples_build_and_run() {
         .and_then(|s| s.parse().ok())
         .expect("the final line reports the mean density error");
     assert!((0.0..5.0).contains(&avg), "mean density error {avg} %");
+
+    // The fountain pours for 1 s by default; half of it shows emitting and draining.
+    let out = run(&build("c_examples/fountain.c", Link::Static), &["0.5"]);
+    assert!(out.starts_with("fountain: 1444 fluid"), "{out}");
+    let last = out.lines().last().unwrap_or_default();
+    assert!(
+        last.starts_with("final: ") && last.ends_with("escaped 0, nan 0"),
+        "{out}"
+    );
+    // "final: steps N, emitted N, removed N, fluid N, escaped 0, nan 0"
+    let count = |key: &str| -> u64 {
+        last.trim_start_matches("final: ")
+            .split(", ")
+            .find_map(|pair| pair.strip_prefix(key)?.trim().parse().ok())
+            .unwrap_or_else(|| panic!("the final line reports {key}: {last}"))
+    };
+    let (emitted, removed, fluid) = (count("emitted"), count("removed"), count("fluid"));
+    assert!(emitted > 0 && removed > 0, "{out}");
+    assert_eq!(fluid + removed, 1444 + emitted, "{out}");
 }
 
 #[test]
@@ -319,6 +354,7 @@ fn c_tests_are_clean_under_valgrind() {
         ("tests/c/obj.c", &[obj_dir.as_str()][..]),
         ("tests/c/parallel.c", &["2"][..]),
         ("tests/c/bodies.c", &["2"][..]),
+        ("tests/c/emitters.c", &[][..]),
     ] {
         let program = build(source, Link::Static);
         let output = Command::new("valgrind")

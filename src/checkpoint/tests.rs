@@ -124,26 +124,31 @@ fn damaged_truncated_and_foreign_files_are_refused() {
 /// the removed count, the emitter's progress and the boxes are in the checkpoint.
 #[test]
 fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
+    use crate::scene::BoxSpec;
     use crate::{EmitterShape, EmitterSpec};
-    let scene = small_scene();
+    // The emitter, sink and domain come from the scene, the removal by id from the caller.
+    let mut scene = small_scene();
+    scene.emitters.push(EmitterSpec {
+        shape: EmitterShape::Disc { radius: 0.08 },
+        position: Vec3::new(0.15, 0.7, 0.3),
+        direction: Vec3::new(0.3, -1.0, 0.0),
+        speed: 1.2,
+        end_time: Some(0.5),
+    });
+    scene.sinks.push(BoxSpec {
+        min: [0.0; 3],
+        max: [0.15, 0.2, 0.65],
+    });
+    let mut domain = scene.containers[0].clone();
+    domain.max[0] = 0.28;
+    scene.domain = Some(BoxSpec {
+        min: domain.min,
+        max: domain.max,
+    });
     let build = || {
         let mut world = scene.build_world().unwrap();
-        let spec = EmitterSpec {
-            shape: EmitterShape::Disc { radius: 0.08 },
-            position: Vec3::new(0.15, 0.7, 0.3),
-            direction: Vec3::new(0.3, -1.0, 0.0),
-            speed: 1.2,
-            end_time: Some(0.5),
-        };
-        world.add_emitter(spec).unwrap();
-        let sink = crate::boundary::Aabb {
-            min: Vec3::new(0.0, 0.0, 0.0),
-            max: Vec3::new(0.15, 0.2, 0.65),
-        };
-        world.add_sink(sink).unwrap();
-        let mut domain = world.containers()[0];
-        domain.max.x = 0.28;
-        world.set_domain(Some(domain)).unwrap();
+        let ids = world.ids();
+        world.remove_particles(&ids[..3]).unwrap();
         world
     };
     let mut reference = build();
@@ -156,8 +161,17 @@ fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
     let path = temp("emitters.pfck");
     write_checkpoint(&path, &scene, &interrupted, None).unwrap();
     drop(interrupted);
-    let mut resumed = read_checkpoint(&path, Some(1)).unwrap().world;
+    let restored = read_checkpoint(&path, Some(1)).unwrap();
     std::fs::remove_file(&path).unwrap();
+    assert_eq!(restored.scene.emitters, scene.emitters);
+    assert_eq!(
+        (
+            restored.world.emitters().len(),
+            restored.world.sinks().len()
+        ),
+        (1, 1)
+    );
+    let mut resumed = restored.world;
     assert_eq!(resumed.export_state(), reference.export_state());
     for _ in 0..20 {
         reference.step().unwrap();

@@ -3,16 +3,18 @@
 
 mod bodies;
 mod error;
+mod flow;
 mod obstacles;
 mod print;
 #[cfg(test)]
 mod tests;
 
-use super::{ContainerSpec, FluidBlock, OutputSpec, Scene};
+use super::{BoxSpec, ContainerSpec, FluidBlock, OutputSpec, Scene};
 use crate::Error;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use bodies::BodyFile;
 use error::json_error;
+use flow::EmitterFile;
 use obstacles::ObstacleFile;
 use print::inline_number_arrays;
 use serde::de::value::{MapAccessDeserializer, SeqAccessDeserializer};
@@ -39,6 +41,12 @@ struct SceneFile {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     bodies: Option<Vec<BodyFile>>,
     fluid_blocks: Vec<FluidBlock>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    emitters: Option<Vec<EmitterFile>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sinks: Option<Vec<BoxSpec>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    domain: Option<BoxSpec>,
     solver: Option<SolverFile>,
     time: Option<TimeFile>,
     viscosity: Option<f64>,
@@ -216,6 +224,13 @@ impl SceneFile {
             .enumerate()
             .map(|(i, b)| b.into_body(i, base))
             .collect::<Result<_, _>>()?;
+        let emitters = self
+            .emitters
+            .unwrap_or_default()
+            .into_iter()
+            .enumerate()
+            .map(|(i, e)| e.into_spec(i))
+            .collect::<Result<_, _>>()?;
         let o = self.output.unwrap_or_default();
         Ok(Scene {
             name: self.name.unwrap_or_else(|| default_name.to_string()),
@@ -225,6 +240,9 @@ impl SceneFile {
             obstacles,
             bodies,
             fluid_blocks: self.fluid_blocks,
+            emitters,
+            sinks: self.sinks.unwrap_or_default(),
+            domain: self.domain,
             duration: self.duration,
             output: OutputSpec {
                 dir: o.dir.map(PathBuf::from),
@@ -257,6 +275,10 @@ impl SceneFile {
             bodies: Some(scene.bodies.iter().map(BodyFile::from_body).collect())
                 .filter(|b: &Vec<BodyFile>| !b.is_empty()),
             fluid_blocks: scene.fluid_blocks.clone(),
+            emitters: Some(scene.emitters.iter().map(EmitterFile::from_spec).collect())
+                .filter(|e: &Vec<EmitterFile>| !e.is_empty()),
+            sinks: Some(scene.sinks.clone()).filter(|s| !s.is_empty()),
+            domain: scene.domain,
             solver: Some(SolverFile {
                 kind: Some(p.solver),
                 rho: Some(if c.auto_rho {

@@ -106,3 +106,23 @@ impl Default for OutputSpec {
         }
     }
 }
+
+/// An axis-aligned box given by its corners: a sink, or the domain.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxSpec {
+    /// Lower corner (m).
+    pub min: [f64; 3],
+    /// Upper corner (m), at least `min` along every axis.
+    pub max: [f64; 3],
+}
+
+impl BoxSpec {
+    /// The box as an [`Aabb`](crate::boundary::Aabb).
+    pub fn aabb(&self) -> crate::boundary::Aabb {
+        crate::boundary::Aabb {
+            min: crate::Vec3::from(self.min),
+            max: crate::Vec3::from(self.max),
+        }
+    }
+}

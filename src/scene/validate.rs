@@ -63,7 +63,7 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
         }
         check_inside(i, b, &scene.containers, 2.0 * r)?;
     }
-    Ok(())
+    super::flow::check_flow(scene)
 }
 
 /// An obstacle-style mesh source (the obstacle or body mesh at JSON key `key`): a known

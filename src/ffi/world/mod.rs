@@ -1,5 +1,6 @@
 //! `PfWorld`, the opaque handle over a [`World`], with the functions that create and destroy
-//! it; the functions that fill it, step it and read it are in [`fill`], [`step`] and [`read`].
+//! it; the functions that fill it, let fluid in and out, step it and read it are in
+//! [`fill`], [`flow`], [`step`] and [`read`].
 
 use super::checked::Args;
 use super::params::PfParams;
@@ -8,14 +9,16 @@ use crate::{Params, World};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
 use std::thread::JoinHandle;
 
-// cbindgen lists functions in the order their modules are declared: fill, step, read (the
-// blank line keeps rustfmt from sorting them).
+// cbindgen lists functions in the order their modules are declared: fill, flow, step, read
+// (the blank line keeps rustfmt from sorting them).
 mod fill;
+mod flow;
 mod step;
 
 mod read;
 
 pub use fill::*;
+pub use flow::*;
 pub use read::*;
 pub use step::*;
 

@@ -208,20 +208,23 @@ impl Body {
     /// Moves the body to where it is at the end of a step of `dt` seconds that ends at time
     /// `end` (s): by its script, or with its velocity (static bodies stay).
     pub(crate) fn advance_pose(&mut self, dt: f64, end: f64) {
-        match (self.kind, self.motion) {
-            (BodyKind::Static, _) => {}
-            (_, None) if self.target.is_some() => {
-                let target = self.target.take().expect("checked");
-                let from = self.centre_of_mass();
-                let to = target.apply(&self.centre);
-                let turn = target.rotation * self.pose.rotation.inverse();
-                self.velocity = Velocity {
-                    linear: (to - from) / dt,
-                    angular: turn.scaled_axis() / dt,
-                };
-                self.pose = target;
-            }
-            (_, Some((script, initial))) => {
+        if self.kind == BodyKind::Static {
+            return;
+        }
+        // A target pose is for bodies without a script (the setters refuse scripted ones).
+        if let Some(target) = self.target.take().filter(|_| self.motion.is_none()) {
+            let from = self.centre_of_mass();
+            let to = target.apply(&self.centre);
+            let turn = target.rotation * self.pose.rotation.inverse();
+            self.velocity = Velocity {
+                linear: (to - from) / dt,
+                angular: turn.scaled_axis() / dt,
+            };
+            self.pose = target;
+            return;
+        }
+        match self.motion {
+            Some((script, initial)) => {
                 let (pose, velocity) = script.at(&initial, end);
                 // The script moves the frame's origin; report the centre of mass's velocity.
                 self.pose = pose;
@@ -231,7 +234,7 @@ impl Body {
                     angular: velocity.angular,
                 };
             }
-            _ => {
+            None => {
                 let centre = self.centre_of_mass() + self.velocity.linear * dt;
                 let rotation =
                     Rotation::from_scaled_axis(self.velocity.angular * dt) * self.pose.rotation;

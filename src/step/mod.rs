@@ -98,9 +98,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    for body in bodies.iter_mut() {
-        body.advance_pose(dt, time + dt);
-    }
+    advance_poses(bodies, dt, time);
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
@@ -158,11 +156,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
             &mut timings,
         )
     });
-    // The fastest body particle or inflow (m/s).
-    let speed = bodies
-        .iter()
-        .map(|b| b.max_particle_speed())
-        .fold(inflow_speed, f64::max);
+    let speed = fastest_inflow(bodies, inflow_speed);
     let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, speed));
     (stats, next_dt)
 }
@@ -181,17 +175,14 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         ..
     } = ctx;
     let gravity = Vec3::from(params.gravity);
+    advance_poses(bodies, dt, time);
     for body in bodies.iter_mut() {
-        body.advance_pose(dt, time + dt);
         body.force = Vec3::zeros();
         body.torque = Vec3::zeros();
         body.accelerate(dt, gravity);
     }
     *wall_load = Load::default();
-    let speed = bodies
-        .iter()
-        .map(|b| b.max_particle_speed())
-        .fold(inflow_speed, f64::max);
+    let speed = fastest_inflow(bodies, inflow_speed);
     let stats = StepStats {
         dt,
         outer_iterations: 0,
@@ -205,6 +196,21 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
     };
     let next_dt = pool.install(|| next_step_size(params, &[], gravity, dt, speed));
     (stats, next_dt)
+}
+
+/// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s).
+fn advance_poses(bodies: &mut [Body], dt: f64, time: f64) {
+    for body in bodies.iter_mut() {
+        body.advance_pose(dt, time + dt);
+    }
+}
+
+/// The fastest body particle or emitter inflow `inflow_speed` (m/s), for the CFL rule.
+fn fastest_inflow(bodies: &[Body], inflow_speed: f64) -> f64 {
+    bodies
+        .iter()
+        .map(|b| b.max_particle_speed())
+        .fold(inflow_speed, f64::max)
 }
 
 /// The moving bodies' particles at their poses: position (m), ψ (kg) and owner.

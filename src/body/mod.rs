@@ -11,11 +11,13 @@
 //! A body's frame is the frame its mesh is given in; velocities are those of the centre of
 //! mass (linear, m/s) and about it (angular, rad/s, in world axes).
 
+mod inset;
 mod mass;
 mod motion;
 mod pose;
 mod shape;
 
+pub(crate) use inset::inset;
 pub use mass::MassProperties;
 pub use motion::Oscillation;
 pub use pose::{Pose, Rotation, Velocity};

@@ -100,7 +100,7 @@ impl TriangleMesh {
     }
 
     /// The corners of triangle `t` (m); `t` must be below the triangle count.
-    fn corners(&self, t: usize) -> [Vec3; 3] {
+    pub(crate) fn corners(&self, t: usize) -> [Vec3; 3] {
         self.triangles[t].map(|i| self.vertices[i as usize])
     }
 

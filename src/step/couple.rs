@@ -1,29 +1,28 @@
 //! The fluid's loads on the boundary (docs/method.md §11.3).
 //!
-//! The distribution over owners comes from the constraint corrections: k·c_{i,j} is the force
-//! of constraint i on particle j (N) at the fixed point of the global step, and the part of
-//! constraint i's correction of its own centre that stems from the boundary particles in its
-//! density is their push on particle i. By the third law each boundary particle b receives
+//! A step moves every fluid particle from its prediction s to x^{n+1}, and the outer iteration
+//! says exactly how: each global step is affine in the iterate, X̃_j − s_j =
+//! Δt²k (n_j (X_j − s_j) + Σ_i c_{i,j}) / Â_jj, and Chebyshev's extrapolation is an affine
+//! combination of iterates. The only terms of Σ_i c_{i,j} that come from boundary particles
+//! are those of particle j's own constraint: its centre correction λ_j w_j ∇_{x_j}C_j has the
+//! boundary part λ_j w_j (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b). So the part u_{j,o} of the displacement
+//! x_j − s_j that the particles of owner o caused follows the same recurrence, with those terms
+//! alone as its source; it is carried along the iteration in one slot per fluid particle and
+//! owner in reach. The owner's load is the opposite of the momentum it gave the fluid:
+//! F_o = −(m/Δt²) Σ_j u_{j,o}, its moment about the origin Σ_j x_j × f_{j,o} (each pair force
+//! lies on the line through the two particles, so x_j is as good an arm as x_b).
 //!
-//! r_b = −k · (λ_i w_i) · (ψ_b/ρ0) · ∇W(x_i − x_b),
-//!
-//! summed over the fluid particles i near it. The scale comes from the fluid's momentum: the
-//! iteration stops at τ, before the corrections reach their fixed point, and the neighbour-count
-//! weighting does not conserve momentum between fluid particles, so the raw sums miss the
-//! momentum the fluid actually exchanged. That momentum is exact: the boundaries together took
-//! K = −Σ_i m (x_i^{n+1} − s_i)/Δt² (N) from the fluid in this step. Every raw load is scaled by
-//! the one factor α = (K·R)/|R|², R = Σ r_b, so that the loads add up to K along R.
-//!
-//! Gathered per block of fluid particles of fixed size and summed in block order, so that the
-//! result does not depend on the thread count.
+//! Slots are listed in particle order and summed in blocks of fixed size in block order, so
+//! the loads do not depend on the thread count.
 
 use crate::Vec3;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Projection};
-use crate::neighbors::{NeighborLists, PointsByComponent};
+use crate::neighbors::NeighborLists;
+use crate::solver::Chebyshev;
 use rayon::prelude::*;
 
-/// Fluid particles per block of the reduction.
+/// Slots per block of the final reduction.
 const BLOCK: usize = 1024;
 
 /// What the fluid exerted on one owner of boundary particles during a step.
@@ -47,130 +46,158 @@ impl Load {
     }
 }
 
-/// What the loads are computed from: the last local step's projections, made at `x`.
-pub(super) struct Reaction<'a> {
-    /// Stiffness k (N/m).
-    pub stiffness: f64,
+/// The boundary's share of the fluid's displacement, per fluid particle and owner in reach,
+/// at the last three iterates of the outer iteration (m).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Coupling {
+    /// The fluid particle of each slot.
+    particle: Vec<u32>,
+    /// The owner of each slot: body o, or the number of bodies for the walls and obstacles.
+    owner: Vec<u32>,
+    previous: Vec<Vec3>,
+    current: Vec<Vec3>,
+    next: Vec<Vec3>,
+    /// The number of bodies.
+    bodies: usize,
+}
+
+/// What one update of the shares reads: the local step's projections made at `x` = X^(k).
+pub(super) struct Iterate<'a> {
     pub constraint: &'a DensityConstraint,
     pub boundary: &'a Boundary,
     pub fluid_lists: &'a NeighborLists,
     pub boundary_lists: &'a NeighborLists,
-    /// The fluid positions the projections were made at, X^(k) (m).
+    /// X^(k) (m).
     pub x: &'a [Vec3],
     pub projections: &'a [Projection],
-    /// Projection weights w_i.
+    /// Projection weights w_j.
     pub weights: &'a [f64],
-    /// The inertial prediction s (m).
-    pub predicted: &'a PointsByComponent,
-    /// The positions at the end of the step, x^{n+1} (m).
-    pub positions: &'a [Vec3],
-    /// Step size (s).
-    pub dt: f64,
+    /// Â_jj = m + Δt²k n_j (kg).
+    pub diagonal: &'a [f64],
+    /// Δt²k (kg).
+    pub dt2k: f64,
+    /// Chebyshev's recurrence and weight ω, when the step's extrapolation changes the iterate.
+    pub chebyshev: Option<(&'a Chebyshev, f64)>,
 }
 
-impl Reaction<'_> {
-    /// The loads on every owner of boundary particles: `out[o]` for body `o` (o < `bodies`)
-    /// and `out[bodies]` for the walls and obstacles.
-    pub fn loads(&self, bodies: usize, out: &mut Vec<Load>) {
-        let n = self.x.len();
-        let mass_per_dt2 = self.constraint.mass / (self.dt * self.dt);
-        let partial: Vec<(Vec<Load>, Vec3)> = (0..n.div_ceil(BLOCK))
+impl Coupling {
+    /// Starts a step: one slot, set to zero, for every fluid particle and every owner of a
+    /// boundary particle in its reach.
+    pub fn start(&mut self, boundary: &Boundary, boundary_lists: &NeighborLists, bodies: usize) {
+        self.bodies = bodies;
+        let owner_of = |k: u32| (boundary.owner[k as usize] as usize).min(bodies) as u32;
+        let slots: Vec<(u32, u32)> = (0..boundary_lists.len())
             .into_par_iter()
-            .map(|block| {
-                let mut sums = vec![Load::default(); bodies + 1];
-                let mut taken = Vec3::zeros();
-                for i in block * BLOCK..((block + 1) * BLOCK).min(n) {
-                    self.add_particle(i, bodies, &mut sums);
-                    taken -= (self.positions[i] - self.predicted.at(i)) * mass_per_dt2;
+            .flat_map_iter(|i| {
+                let mut owners: Vec<u32> =
+                    boundary_lists.of(i).iter().map(|&k| owner_of(k)).collect();
+                owners.sort_unstable();
+                owners.dedup();
+                owners.into_iter().map(move |o| (i as u32, o))
+            })
+            .collect();
+        self.particle.clear();
+        self.owner.clear();
+        self.particle.extend(slots.iter().map(|s| s.0));
+        self.owner.extend(slots.iter().map(|s| s.1));
+        for u in [&mut self.previous, &mut self.current, &mut self.next] {
+            u.clear();
+            u.resize(slots.len(), Vec3::zeros());
+        }
+    }
+
+    /// Follows one outer iteration: the shares at X^(k+1) from those at X^(k) and X^(k−1)
+    /// and the boundary's corrections at X^(k).
+    pub(super) fn update(&mut self, it: &Iterate) {
+        let (current, previous) = (&self.current, &self.previous);
+        self.next.par_iter_mut().enumerate().for_each(|(s, next)| {
+            let j = self.particle[s] as usize;
+            let source = it.boundary_correction(j, self.owner[s], self.bodies);
+            let members = it.constraint.membership(it.fluid_lists, j);
+            let plain = (current[s] * members + source) * (it.dt2k / it.diagonal[j]);
+            *next = match it.chebyshev {
+                Some((chebyshev, omega)) => {
+                    chebyshev.extrapolated(omega, plain, current[s], previous[s])
                 }
-                (sums, taken)
+                None => plain,
+            };
+        });
+        std::mem::swap(&mut self.previous, &mut self.current);
+        std::mem::swap(&mut self.current, &mut self.next);
+    }
+
+    /// The loads of the step that ended at `x` (m) with step size `dt` (s) on every owner:
+    /// `out[o]` for body o and `out[bodies]` for the walls and obstacles.
+    pub fn loads(&self, mass: f64, x: &[Vec3], dt: f64, out: &mut Vec<Load>) {
+        let scale = -mass / (dt * dt);
+        let bodies = self.bodies;
+        let partial: Vec<Vec<Load>> = self
+            .current
+            .par_chunks(BLOCK)
+            .enumerate()
+            .map(|(block, shares)| {
+                let mut sums = vec![Load::default(); bodies + 1];
+                for (s, u) in (block * BLOCK..).zip(shares) {
+                    let force = u * scale;
+                    let arm = x[self.particle[s] as usize];
+                    sums[self.owner[s] as usize].add(&Load {
+                        force,
+                        moment: arm.cross(&force),
+                    });
+                }
+                sums
             })
             .collect();
         out.clear();
         out.resize(bodies + 1, Load::default());
-        let mut taken = Vec3::zeros();
-        for (sums, t) in &partial {
+        for sums in &partial {
             for (o, s) in out.iter_mut().zip(sums) {
                 o.add(s);
             }
-            taken += t;
-        }
-        let raw = out.iter().fold(Vec3::zeros(), |r, l| r + l.force);
-        let r2 = raw.norm_squared();
-        let alpha = if r2 > 0.0 {
-            (taken.dot(&raw) / r2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        for load in out.iter_mut() {
-            load.force *= alpha;
-            load.moment *= alpha;
         }
     }
+}
 
-    /// Adds the reaction to constraint i's projection to `sums`: the net correction the
-    /// constraint gave its fluid members, k λ_i Σ_m w_m ∇_{x_m}C_i (N), taken by the boundary
-    /// particles in its density, each in proportion to ψ_b |∇W(x_i − x_b)|.
-    fn add_particle(&self, i: usize, bodies: usize, sums: &mut [Load]) {
-        let near = self.boundary_lists.of(i);
-        let p = &self.projections[i];
-        if near.is_empty() || p.self_correction == Vec3::zeros() {
-            return;
+impl Iterate<'_> {
+    /// The part of constraint j's correction of its own particle that the boundary particles
+    /// of `owner` cause: λ_j w_j (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b) over them (m).
+    fn boundary_correction(&self, j: usize, owner: u32, bodies: usize) -> Vec3 {
+        let p = &self.projections[j];
+        if p.self_correction == Vec3::zeros() {
+            return Vec3::zeros();
         }
         let c = self.constraint;
         let b = self.boundary;
-        let xi = self.x[i];
-        let w_i = self.weights[i];
-        let (centre, members) = self.gradients(i);
+        let xj = self.x[j];
+        let near = self.boundary_lists.of(j);
+        let gradient = |k: u32| {
+            let k = k as usize;
+            c.kernel.grad_w(&(xj - b.positions[k])) * (b.psi[k] / c.rest_density)
+        };
+        let of_owner: Vec3 = near
+            .iter()
+            .filter(|&&k| (b.owner[k as usize] as usize).min(bodies) as u32 == owner)
+            .map(|&k| gradient(k))
+            .sum();
+        let w_j = self.weights[j];
         let lambda = if p.materialized {
             // Several projection steps: the multiplier that gives the whole correction of the
             // centre along the gradient at x.
-            let g2 = centre.norm_squared() * w_i;
+            let fluid: Vec3 = self
+                .fluid_lists
+                .of(j)
+                .iter()
+                .map(|&i| c.kernel.grad_w(&(xj - self.x[i as usize])) * (c.mass / c.rest_density))
+                .sum();
+            let all: Vec3 = near.iter().map(|&k| gradient(k)).sum::<Vec3>() + fluid;
+            let g2 = all.norm_squared() * w_j;
             if g2 == 0.0 {
-                return;
+                return Vec3::zeros();
             }
-            p.self_correction.dot(&centre) / g2
+            p.self_correction.dot(&all) / g2
         } else {
             p.lambda
         };
-        let net = (centre * w_i + members) * (self.stiffness * lambda);
-        let share = |k: u32| {
-            let k = k as usize;
-            b.psi[k] * c.kernel.grad_w(&(xi - b.positions[k])).norm()
-        };
-        let total: f64 = near.iter().map(|&k| share(k)).sum();
-        if total == 0.0 {
-            return;
-        }
-        for &k in near {
-            let f = -net * (share(k) / total);
-            let xb = b.positions[k as usize];
-            let owner = (b.owner[k as usize] as usize).min(bodies);
-            sums[owner].add(&Load {
-                force: f,
-                moment: xb.cross(&f),
-            });
-        }
-    }
-
-    /// ∇_{x_i} C_i at x (1/m, docs/method.md §2.4) and Σ_j w_j ∇_{x_j} C_i over the fluid
-    /// neighbours j (1/m).
-    fn gradients(&self, i: usize) -> (Vec3, Vec3) {
-        let c = self.constraint;
-        let xi = self.x[i];
-        let (mut fluid, mut members) = (Vec3::zeros(), Vec3::zeros());
-        for &j in self.fluid_lists.of(i) {
-            let g = c.kernel.grad_w(&(xi - self.x[j as usize])) * c.mass;
-            fluid += g;
-            members -= g * self.weights[j as usize];
-        }
-        let b = self.boundary;
-        let walls: Vec3 = self
-            .boundary_lists
-            .of(i)
-            .iter()
-            .map(|&k| c.kernel.grad_w(&(xi - b.positions[k as usize])) * b.psi[k as usize])
-            .sum();
-        ((fluid + walls) / c.rest_density, members / c.rest_density)
+        of_owner * (lambda * w_j)
     }
 }

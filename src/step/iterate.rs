@@ -3,7 +3,7 @@
 //! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until no particle moved farther
 //! than τ.
 
-use super::StepBuffers;
+use super::{StepBuffers, couple};
 use crate::boundary::Boundary;
 use crate::constraint::{CHUNK, DensityConstraint, Neighborhood};
 use crate::params::{Params, SolverKind};
@@ -22,6 +22,8 @@ pub(super) struct Iteration<'a> {
     pub chebyshev: &'a mut Chebyshev,
     /// Step size (s).
     pub dt: f64,
+    /// Follow the boundary's share of the displacement in `b.coupling` (worlds with bodies).
+    pub couple: bool,
 }
 
 /// How the iteration ended.
@@ -46,6 +48,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         solver,
         chebyshev,
         dt,
+        couple,
     } = it;
     // The system matrix of formulation F1, frozen for the step.
     let mass = constraint.mass;
@@ -78,6 +81,27 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         let t = Instant::now();
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
         let t_local = t.elapsed().as_secs_f64();
+        let omega = if accelerate {
+            chebyshev.next_weight(outer)
+        } else {
+            1.0
+        };
+        let extrapolation =
+            (accelerate && chebyshev.changes(omega)).then_some((&*chebyshev, omega));
+        if couple {
+            b.coupling.update(&couple::Iterate {
+                constraint,
+                boundary,
+                fluid_lists: &b.fluid_lists,
+                boundary_lists: &b.boundary_lists,
+                x: &b.current,
+                projections: &b.projections,
+                weights: &b.weights,
+                diagonal: &b.system.diagonal,
+                dt2k,
+                chebyshev: extrapolation,
+            });
+        }
         let (projections, corrections) = (&b.projections, &b.corrections);
         let (current, predicted) = (&b.current, b.fluid_lists.searched_points());
         // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
@@ -91,16 +115,11 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
             }
         };
         if single_sweep {
-            let omega = if accelerate {
-                chebyshev.next_weight(outer)
-            } else {
-                1.0
-            };
             let sweep = Sweep {
                 diagonal: &b.system.diagonal,
                 current,
                 previous: &b.previous,
-                chebyshev: (accelerate && chebyshev.changes(omega)).then_some((&*chebyshev, omega)),
+                chebyshev: extrapolation,
             };
             // The right-hand side lives only as long as its chunk's sweep.
             displacement = b
@@ -124,7 +143,6 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
             b.next.copy_from_slice(&b.current);
             inner += solver.solve(&b.system, &b.rhs, &mut b.next);
             if accelerate {
-                let omega = chebyshev.next_weight(outer);
                 chebyshev.extrapolate(omega, &mut b.next, &b.current, &b.previous);
             }
             displacement = max_distance(&b.next, &b.current);

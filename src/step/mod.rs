@@ -10,7 +10,7 @@ mod finish;
 mod iterate;
 mod search;
 
-pub(crate) use couple::Load;
+pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
 
 use crate::body::Body;
@@ -51,6 +51,8 @@ pub(crate) struct StepBuffers {
     scratch_ids: Vec<u64>,
     /// δ_k of every outer iteration of the last step (m).
     pub(crate) displacements: Vec<f64>,
+    /// The boundary's share of the fluid's displacement, in worlds with bodies.
+    coupling: Coupling,
     /// The fluid's load on each body and, last, on the walls.
     loads: Vec<Load>,
 }
@@ -108,6 +110,12 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         }
         search::reorder_and_search(grid, fluid, boundary, params.support_radius(), buffers);
         timings.neighbors = started.elapsed().as_secs_f64();
+        let couple = !bodies.is_empty();
+        if couple {
+            buffers
+                .coupling
+                .start(boundary, &buffers.boundary_lists, bodies.len());
+        }
         let outcome = iterate::iterate(
             iterate::Iteration {
                 params,
@@ -116,31 +124,22 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
                 solver,
                 chebyshev,
                 dt,
+                couple,
             },
             buffers,
             &mut timings,
         );
-        if !bodies.is_empty() {
-            couple::Reaction {
-                stiffness: params.stiffness,
-                constraint,
-                boundary,
-                fluid_lists: &buffers.fluid_lists,
-                boundary_lists: &buffers.boundary_lists,
-                x: &buffers.previous,
-                projections: &buffers.projections,
-                weights: &buffers.weights,
-                predicted: buffers.fluid_lists.searched_points(),
-                positions: &buffers.current,
-                dt,
-            }
-            .loads(bodies.len(), &mut buffers.loads);
-            for (body, load) in bodies.iter_mut().zip(&buffers.loads) {
+        if couple {
+            let loads = &mut buffers.loads;
+            buffers
+                .coupling
+                .loads(constraint.mass, &buffers.current, dt, loads);
+            for (body, load) in bodies.iter_mut().zip(loads.iter()) {
                 body.force = load.force;
                 body.torque = load.torque_about(&body.centre_of_mass());
                 body.accelerate(dt, gravity);
             }
-            *wall_load = buffers.loads[bodies.len()];
+            *wall_load = loads[bodies.len()];
         }
         finish::finish(
             finish::Finish {

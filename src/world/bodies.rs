@@ -2,7 +2,7 @@
 //! steps, and reading their poses and the fluid's loads on them and on the walls.
 
 use super::{MAX_PARTICLES, World};
-use crate::body::{Body, BodyKind, BodySpec, Pose, Velocity};
+use crate::body::{Body, BodyKind, BodySpec, Pose, Velocity, inset};
 use crate::boundary::mesh::{sample_count_bound, sample_poisson_disk};
 use crate::boundary::own_masses;
 use crate::{Error, Vec3};
@@ -15,7 +15,9 @@ pub type BodyId = usize;
 
 impl World {
     /// Adds a rigid body: its mesh is sampled in the body frame by Poisson disk with a
-    /// minimum distance of one particle radius r, like an obstacle. A static body's particles
+    /// minimum distance of one particle radius r, like an obstacle, and for a closed mesh the
+    /// samples are set back r into the body (half way through parts thinner than 2r), so that
+    /// the fluid, which keeps about r from boundary particles, meets the mesh itself. A static body's particles
     /// join the walls' (their Akinci volumes are computed with the walls'); a moving body's
     /// volumes are computed once over its own particles. Returns the body's id. Errors,
     /// leaving the world unchanged, on a bad spec (named field), a mesh that is far larger
@@ -48,7 +50,8 @@ impl World {
                 ),
             ));
         }
-        let samples = sample_poisson_disk(&spec.mesh, r);
+        let on_surface = sample_poisson_disk(&spec.mesh, r);
+        let samples = self.pool.install(|| inset(&spec.mesh, &on_surface, r));
         let id = self.bodies.len();
         let owner = u32::try_from(id)
             .ok()

@@ -338,6 +338,37 @@ fn c_examples_build_and_run() {
     assert_eq!(fluid + removed, 1444 + emitted, "{out}");
 }
 
+/// coupling.c floats a box as a kinematic body moved by its own integrator from the loads it
+/// reads, and as the library's dynamic body: both settle at the same height, at rest, with the
+/// box floating (below where it was dropped, well above the floor).
+#[test]
+fn a_box_coupled_through_the_c_api_floats_like_the_dynamic_body() {
+    let program = build("c_examples/coupling.c", Link::Static);
+    let settle = |mode: &str| -> (f64, f64) {
+        let out = run(&program, &[mode, "2.5"]);
+        let last = out.lines().last().unwrap_or_default();
+        assert!(last.ends_with("escaped 0, nan 0"), "{out}");
+        // "final: centre Y m, speed S m/s, steps N, escaped 0, nan 0"
+        let number = |key: &str| -> f64 {
+            last.split(key)
+                .nth(1)
+                .and_then(|s| s.split_whitespace().next())
+                .and_then(|s| s.parse().ok())
+                .unwrap_or_else(|| panic!("the final line reports {key}: {last}"))
+        };
+        (number("centre "), number("speed "))
+    };
+    let (coupled, coupled_speed) = settle("coupled");
+    let (dynamic, dynamic_speed) = settle("dynamic");
+    assert!(
+        (coupled - dynamic).abs() < 0.005,
+        "coupled box at {coupled} m, dynamic box at {dynamic} m"
+    );
+    assert!(coupled_speed < 0.05 && dynamic_speed < 0.05);
+    // Dropped with its centre at 0.405 m; the water is about 0.3 m deep.
+    assert!((0.25..0.37).contains(&coupled), "{coupled}");
+}
+
 #[test]
 fn c_tests_are_clean_under_valgrind() {
     if !tools::available("valgrind") {

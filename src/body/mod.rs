@@ -23,6 +23,7 @@ pub use motion::Oscillation;
 pub use pose::{Pose, Rotation, Velocity};
 pub use shape::Shape;
 
+use crate::boundary::Aabb;
 use crate::boundary::mesh::TriangleMesh;
 use crate::{Error, Vec3};
 use nalgebra::Matrix3;
@@ -242,6 +243,37 @@ impl Body {
                     Rotation::from_scaled_axis(self.velocity.angular * dt) * self.pose.rotation;
                 self.place_centre(centre, rotation);
             }
+        }
+    }
+
+    /// Rigid contact with a container's walls (docs/method.md §11.4): moves a dynamic body
+    /// back so that none of its particles lies closer than `clearance` (m) to a wall of
+    /// `container`, and stops its motion into any wall it touches. Other kinds are unchanged.
+    pub(crate) fn keep_inside(&mut self, container: &Aabb, clearance: f64) {
+        if self.kind != BodyKind::Dynamic {
+            return;
+        }
+        let (lo, hi) = (
+            container.min + Vec3::repeat(clearance),
+            container.max - Vec3::repeat(clearance),
+        );
+        let (mut below, mut above) = (Vec3::zeros(), Vec3::zeros());
+        for p in self.particle_positions() {
+            below = below.sup(&(lo - p));
+            above = above.sup(&(p - hi));
+        }
+        let mut shift = Vec3::zeros();
+        for a in 0..3 {
+            if below[a] > 0.0 {
+                shift[a] = below[a];
+                self.velocity.linear[a] = self.velocity.linear[a].max(0.0);
+            } else if above[a] > 0.0 {
+                shift[a] = -above[a];
+                self.velocity.linear[a] = self.velocity.linear[a].min(0.0);
+            }
+        }
+        if shift != Vec3::zeros() {
+            self.pose.position += shift;
         }
     }
 

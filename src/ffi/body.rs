@@ -181,7 +181,9 @@ fn add_body(
 /// Adds a box-shaped rigid body of `kind` (a `PfBodyKind`) with half-extents
 /// `half_extents[0..3]` (m, along the body's x, y and z axes) centred on its frame's origin,
 /// placed by `*pose`, and stores its id in `*out_id`. Its surface is sampled with boundary
-/// particles about r apart (Poisson disk, as `pf_world_add_mesh`), reproducibly.
+/// particles about r apart (Poisson disk, as `pf_world_add_mesh`), reproducibly, and the
+/// samples are set back r into the body (half way through parts thinner than 2r), so that
+/// the fluid meets the box's own surface and a floating box displaces its own volume.
 ///
 /// `density` (kg/m³) fills the box: it is required (> 0) for `PF_BODY_DYNAMIC` bodies,
 /// whose mass and inertia it gives; for static and kinematic bodies 0 means none, and a

@@ -54,6 +54,12 @@ pub(crate) struct Coupling {
     particle: Vec<u32>,
     /// The owner of each slot: body o, or the number of bodies for the walls and obstacles.
     owner: Vec<u32>,
+    /// (1/ρ0) Σ_b ψ_b ∇W(s_j − x_b) over the owner's particles b near the slot's particle j,
+    /// at the prediction s (1/m): the step moves the fluid far less than a kernel radius, so
+    /// the boundary's part of ∇C_j is taken once per step.
+    gradient: Vec<Vec3>,
+    /// The same over all boundary particles near j (1/m).
+    all: Vec<Vec3>,
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,
@@ -64,9 +70,7 @@ pub(crate) struct Coupling {
 /// What one update of the shares reads: the local step's projections made at `x` = X^(k).
 pub(super) struct Iterate<'a> {
     pub constraint: &'a DensityConstraint,
-    pub boundary: &'a Boundary,
     pub fluid_lists: &'a NeighborLists,
-    pub boundary_lists: &'a NeighborLists,
     /// X^(k) (m).
     pub x: &'a [Vec3],
     pub projections: &'a [Projection],
@@ -81,25 +85,51 @@ pub(super) struct Iterate<'a> {
 }
 
 impl Coupling {
-    /// Starts a step: one slot, set to zero, for every fluid particle and every owner of a
-    /// boundary particle in its reach.
-    pub fn start(&mut self, boundary: &Boundary, boundary_lists: &NeighborLists, bodies: usize) {
+    /// Starts a step at the prediction `s` (m): one slot, set to zero, for every fluid
+    /// particle and every owner of a boundary particle in its reach.
+    pub fn start(
+        &mut self,
+        constraint: &DensityConstraint,
+        boundary: &Boundary,
+        boundary_lists: &NeighborLists,
+        s: &[Vec3],
+        bodies: usize,
+    ) {
         self.bodies = bodies;
         let owner_of = |k: u32| (boundary.owner[k as usize] as usize).min(bodies) as u32;
-        let slots: Vec<(u32, u32)> = (0..boundary_lists.len())
+        let slots: Vec<(u32, u32, Vec3, Vec3)> = (0..boundary_lists.len())
             .into_par_iter()
-            .flat_map_iter(|i| {
-                let mut owners: Vec<u32> =
-                    boundary_lists.of(i).iter().map(|&k| owner_of(k)).collect();
+            .flat_map_iter(|j| {
+                let near = boundary_lists.of(j);
+                let gradient = move |k: u32| {
+                    let k = k as usize;
+                    constraint.kernel.grad_w(&(s[j] - boundary.positions[k]))
+                        * (boundary.psi[k] / constraint.rest_density)
+                };
+                let mut owners: Vec<u32> = near.iter().map(|&k| owner_of(k)).collect();
                 owners.sort_unstable();
                 owners.dedup();
-                owners.into_iter().map(move |o| (i as u32, o))
+                let all: Vec3 = near.iter().map(|&k| gradient(k)).sum();
+                owners.into_iter().map(move |o| {
+                    let g = near
+                        .iter()
+                        .filter(|&&k| owner_of(k) == o)
+                        .map(|&k| gradient(k))
+                        .sum();
+                    (j as u32, o, g, all)
+                })
             })
             .collect();
         self.particle.clear();
         self.owner.clear();
-        self.particle.extend(slots.iter().map(|s| s.0));
-        self.owner.extend(slots.iter().map(|s| s.1));
+        self.gradient.clear();
+        self.all.clear();
+        for &(j, o, g, all) in &slots {
+            self.particle.push(j);
+            self.owner.push(o);
+            self.gradient.push(g);
+            self.all.push(all);
+        }
         for u in [&mut self.previous, &mut self.current, &mut self.next] {
             u.clear();
             u.resize(slots.len(), Vec3::zeros());
@@ -112,7 +142,7 @@ impl Coupling {
         let (current, previous) = (&self.current, &self.previous);
         self.next.par_iter_mut().enumerate().for_each(|(s, next)| {
             let j = self.particle[s] as usize;
-            let source = it.boundary_correction(j, self.owner[s], self.bodies);
+            let source = it.boundary_correction(j, &self.gradient[s], &self.all[s]);
             let members = it.constraint.membership(it.fluid_lists, j);
             let plain = (current[s] * members + source) * (it.dt2k / it.diagonal[j]);
             *next = match it.chebyshev {
@@ -160,41 +190,31 @@ impl Coupling {
 
 impl Iterate<'_> {
     /// The part of constraint j's correction of its own particle that the boundary particles
-    /// of `owner` cause: λ_j w_j (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b) over them (m).
-    fn boundary_correction(&self, j: usize, owner: u32, bodies: usize) -> Vec3 {
+    /// of one owner cause: λ_j w_j g (m), where g = (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b) over them
+    /// (`of_owner`) and `all` the same over every boundary particle near j (1/m).
+    fn boundary_correction(&self, j: usize, of_owner: &Vec3, all: &Vec3) -> Vec3 {
         let p = &self.projections[j];
         if p.self_correction == Vec3::zeros() {
             return Vec3::zeros();
         }
-        let c = self.constraint;
-        let b = self.boundary;
-        let xj = self.x[j];
-        let near = self.boundary_lists.of(j);
-        let gradient = |k: u32| {
-            let k = k as usize;
-            c.kernel.grad_w(&(xj - b.positions[k])) * (b.psi[k] / c.rest_density)
-        };
-        let of_owner: Vec3 = near
-            .iter()
-            .filter(|&&k| (b.owner[k as usize] as usize).min(bodies) as u32 == owner)
-            .map(|&k| gradient(k))
-            .sum();
         let w_j = self.weights[j];
         let lambda = if p.materialized {
             // Several projection steps: the multiplier that gives the whole correction of the
             // centre along the gradient at x.
+            let c = self.constraint;
+            let xj = self.x[j];
             let fluid: Vec3 = self
                 .fluid_lists
                 .of(j)
                 .iter()
                 .map(|&i| c.kernel.grad_w(&(xj - self.x[i as usize])) * (c.mass / c.rest_density))
                 .sum();
-            let all: Vec3 = near.iter().map(|&k| gradient(k)).sum::<Vec3>() + fluid;
-            let g2 = all.norm_squared() * w_j;
+            let gradient = all + fluid;
+            let g2 = gradient.norm_squared() * w_j;
             if g2 == 0.0 {
                 return Vec3::zeros();
             }
-            p.self_correction.dot(&all) / g2
+            p.self_correction.dot(&gradient) / g2
         } else {
             p.lambda
         };

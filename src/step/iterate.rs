@@ -91,9 +91,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         if couple {
             b.coupling.update(&couple::Iterate {
                 constraint,
-                boundary,
                 fluid_lists: &b.fluid_lists,
-                boundary_lists: &b.boundary_lists,
                 x: &b.current,
                 projections: &b.projections,
                 weights: &b.weights,

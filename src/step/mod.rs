@@ -14,7 +14,7 @@ pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
 
 use crate::body::Body;
-use crate::boundary::Boundary;
+use crate::boundary::{Aabb, Boundary};
 use crate::constraint::{Corrections, DensityConstraint, Projection};
 use crate::fluid::Fluid;
 use crate::forces::NonPressureForce;
@@ -70,6 +70,8 @@ pub(crate) struct StepContext<'a> {
     pub forces: &'a mut [Box<dyn NonPressureForce>],
     pub buffers: &'a mut StepBuffers,
     pub bodies: &'a mut [Body],
+    /// The containers, which keep dynamic bodies inside (docs/method.md §11.4).
+    pub containers: &'a [Aabb],
     /// The fluid's load on the walls and static obstacles (written).
     pub wall_load: &'a mut Load,
     /// Simulated time at the start of the step (s).
@@ -95,12 +97,13 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         forces,
         buffers,
         bodies,
+        containers,
         wall_load,
         time,
         inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(bodies, dt, time);
+    advance_poses(bodies, containers, params.particle_radius, dt, time);
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
@@ -112,9 +115,13 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         timings.neighbors = started.elapsed().as_secs_f64();
         let couple = !bodies.is_empty();
         if couple {
-            buffers
-                .coupling
-                .start(boundary, &buffers.boundary_lists, bodies.len());
+            buffers.coupling.start(
+                constraint,
+                boundary,
+                &buffers.boundary_lists,
+                &buffers.current,
+                bodies.len(),
+            );
         }
         let outcome = iterate::iterate(
             iterate::Iteration {
@@ -168,13 +175,14 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         params,
         pool,
         bodies,
+        containers,
         wall_load,
         time,
         inflow_speed,
         ..
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(bodies, dt, time);
+    advance_poses(bodies, containers, params.particle_radius, dt, time);
     for body in bodies.iter_mut() {
         body.force = Vec3::zeros();
         body.torque = Vec3::zeros();
@@ -197,10 +205,16 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
     (stats, next_dt)
 }
 
-/// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s).
-fn advance_poses(bodies: &mut [Body], dt: f64, time: f64) {
+/// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s),
+/// keeping each dynamic body's particles at least `clearance` (m) inside the container that
+/// holds its centre of mass.
+fn advance_poses(bodies: &mut [Body], containers: &[Aabb], clearance: f64, dt: f64, time: f64) {
     for body in bodies.iter_mut() {
         body.advance_pose(dt, time + dt);
+        let centre = body.centre_of_mass();
+        if let Some(container) = containers.iter().find(|c| c.contains(&centre, 0.0)) {
+            body.keep_inside(container, clearance);
+        }
     }
 }
 

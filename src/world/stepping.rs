@@ -53,6 +53,7 @@ impl World {
             bodies,
             wall_load,
             time,
+            containers,
             ..
         } = self;
         let context = StepContext {
@@ -67,6 +68,7 @@ impl World {
             forces,
             buffers,
             bodies,
+            containers,
             wall_load,
             time: *time,
             inflow_speed,

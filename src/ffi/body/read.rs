@@ -127,8 +127,9 @@ pub unsafe extern "C" fn pf_body_get_centre_of_mass(
 
 /// Copies the fluid's force on body `id` during the last step into `force[0..3]` (N) and its
 /// torque about the body's centre of mass into `torque[0..3]` (N·m); both are 0 before the
-/// first step. The loads are provisional: their distribution and scale are approximations
-/// (docs/method.md §11.3), accurate in sign but not yet in magnitude.
+/// first step. The load is the momentum the boundary particles of the body took from the
+/// fluid in that step, followed through the solver's iteration (docs/method.md §11.3); an
+/// engine's rigid solver can apply it for two-way coupling (see c_examples/coupling.c).
 ///
 /// Errors: `PF_ERROR_NULL_POINTER` (either array NULL: neither is written),
 /// `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named). Thread safety: one thread at a time
@@ -161,7 +162,7 @@ pub unsafe extern "C" fn pf_body_get_force_torque(
 /// Copies the fluid's force on the container walls, static obstacles and boundary particles
 /// together during the last step into `force[0..3]` (N); static bodies report theirs
 /// separately (`pf_body_get_force_torque`). It is measured only in worlds with bodies, and
-/// is 0 otherwise and before the first step. Provisional, as the bodies' loads.
+/// is 0 otherwise and before the first step. Measured as the bodies' loads are.
 ///
 /// Errors: `PF_ERROR_NULL_POINTER`. Thread safety: one thread at a time per world.
 ///

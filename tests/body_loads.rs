@@ -1,0 +1,277 @@
+//! The fluid's loads on bodies and walls (docs/method.md §11.3) and what they do to dynamic
+//! bodies (§11.4): hydrostatics, buoyancy, and the momentum a kinematic paddle gives the fluid.
+
+use projfluid::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
+use projfluid::boundary::Aabb;
+use projfluid::params::ProjectionWeight;
+use projfluid::scene::Scene;
+use projfluid::{Params, Vec3, World};
+
+const R: f64 = 0.025;
+const D: f64 = 2.0 * R;
+const G: f64 = 9.81;
+const RHO0: f64 = 1000.0;
+
+fn params(weight: ProjectionWeight) -> Params {
+    Params {
+        mass_factor: 1.0,
+        projection_weight: weight,
+        ..Params::with_radius(R)
+    }
+}
+
+fn box_body(kind: BodyKind, half: Vec3, density: Option<f64>, at: Vec3) -> BodySpec {
+    BodySpec {
+        kind,
+        mesh: Shape::Box { half_extents: half }.mesh(R).unwrap(),
+        mass: density.map(BodyMass::Density),
+        pose: Pose {
+            position: at,
+            rotation: Rotation::identity(),
+        },
+        velocity: Velocity::default(),
+        motion: None,
+    }
+}
+
+/// The free surface's height (m) over the fluid particles for which `far` holds: the top
+/// layer's centres (the 99.5th percentile of heights) plus one particle radius.
+fn level(world: &World, far: impl Fn(&Vec3) -> bool) -> f64 {
+    let mut ys: Vec<f64> = world
+        .positions()
+        .iter()
+        .filter(|p| far(p))
+        .map(|p| p.y)
+        .collect();
+    ys.sort_by(f64::total_cmp);
+    ys[ys.len() * 995 / 1000] + R
+}
+
+/// A 1.4 x 1.4 m tank (walls r/4 outside) filled 0.5 m deep around a static box
+/// 0.8 x 0.8 x 0.8 m held with its centre at 0.6 m, so that the settled water covers about
+/// half of it, relaxed for 1 s. Returns the world, the box's id, its half-extent and centre.
+fn held_box(weight: ProjectionWeight) -> (World, usize, f64, Vec3) {
+    let mut world = World::new(params(weight)).unwrap();
+    let (side, e) = (1.4, R / 4.0);
+    world
+        .add_container(
+            Aabb {
+                min: Vec3::repeat(-e),
+                max: Vec3::new(side + e, 1.2, side + e),
+            },
+            1,
+        )
+        .unwrap();
+    let (half, centre) = (0.4, Vec3::new(side / 2.0, 0.6, side / 2.0));
+    let n = (side / D) as usize - 1;
+    let fluid: Vec<Vec3> = (0..n)
+        .flat_map(|i| (0..13).flat_map(move |j| (0..n).map(move |k| (i, j, k))))
+        .map(|(i, j, k)| Vec3::new(i as f64, j as f64, k as f64) * D + Vec3::repeat(D))
+        .filter(|p| (0..3).any(|a| (p[a] - centre[a]).abs() >= half + R))
+        .collect();
+    world.add_fluid_particles(&fluid, None).unwrap();
+    let id = world
+        .add_body(box_body(
+            BodyKind::Static,
+            Vec3::repeat(half),
+            None,
+            centre,
+        ))
+        .unwrap();
+    world.relax(1.0, 6.0).unwrap();
+    (world, id, half, centre)
+}
+
+/// Averages the box's and the walls' vertical loads (N) over `steps` steps.
+fn mean_loads(world: &mut World, id: usize, steps: usize) -> (f64, f64) {
+    let (mut body, mut walls, mut time) = (0.0, 0.0, 0.0);
+    for _ in 0..steps {
+        let dt = world.step().unwrap().dt;
+        body += world.body(id).unwrap().force().y * dt;
+        walls += world.wall_force().y * dt;
+        time += dt;
+    }
+    (body / time, walls / time)
+}
+
+#[test]
+fn a_box_held_half_under_water_feels_the_weight_of_the_water_it_displaces() {
+    let (mut world, id, half, centre) = held_box(ProjectionWeight::NeighborCount);
+    let (up, _) = mean_loads(&mut world, id, 100);
+    let far = |p: &Vec3| (p.x - centre.x).abs() > half + 0.05 || (p.z - centre.z).abs() > half + 0.05;
+    let submerged = level(&world, far) - (centre.y - half);
+    assert!(
+        submerged > 0.3 * half && submerged < 1.7 * half,
+        "the box is not about half under water: {submerged} m of {} m",
+        2.0 * half
+    );
+    let archimedes = RHO0 * G * (2.0 * half).powi(2) * submerged;
+    assert!(
+        (up / archimedes - 1.0).abs() < 0.03,
+        "buoyancy {up:.1} N, ρ0·g·V = {archimedes:.1} N"
+    );
+}
+
+/// With the uniform projection weight the fluid's own forces conserve momentum (§2.5), so
+/// whatever holds the water up is the walls and the box: together they carry its weight.
+#[test]
+fn the_walls_carry_the_weight_of_the_water_and_the_push_of_the_held_box() {
+    let (mut world, id, _, _) = held_box(ProjectionWeight::Uniform);
+    let (up, walls) = mean_loads(&mut world, id, 100);
+    let weight = world.fluid_count() as f64 * world.particle_mass() * G;
+    assert!(up > 0.0);
+    // The water pushes the box up and the floor down; the box pushes back on the water.
+    let carried = -walls - up;
+    assert!(
+        (carried / weight - 1.0).abs() < 0.02,
+        "walls {walls:.1} N and box {up:.1} N for water weighing {weight:.1} N"
+    );
+}
+
+/// Gravity off: a kinematic paddle 6 cm thick moves at 1 m/s for 0.2 s into a block of
+/// water in a closed channel. Returns the fluid's momentum change and the impulse reported
+/// on the paddle and on the walls, along x (N·s).
+fn paddle_push(weight: ProjectionWeight) -> (f64, f64, f64) {
+    let p = Params {
+        gravity: [0.0; 3],
+        ..params(weight)
+    };
+    let mut world = World::new(p).unwrap();
+    let e = R / 4.0;
+    world
+        .add_container(
+            Aabb {
+                min: Vec3::repeat(-e),
+                max: Vec3::new(1.5 + e, 0.5 + e, 0.4 + e),
+            },
+            1,
+        )
+        .unwrap();
+    world
+        .add_fluid_block(Vec3::new(0.3, D, D), [16, 8, 7], Vec3::zeros())
+        .unwrap();
+    let mut paddle = box_body(
+        BodyKind::Kinematic,
+        Vec3::new(0.03, 0.25, 0.2),
+        None,
+        Vec3::new(0.24, 0.25, 0.2),
+    );
+    paddle.velocity.linear = Vec3::new(1.0, 0.0, 0.0);
+    let id = world.add_body(paddle).unwrap();
+    let m = world.particle_mass();
+    let momentum = |w: &World| w.velocities().iter().map(|v| v.x).sum::<f64>() * m;
+    let before = momentum(&world);
+    let (mut on_paddle, mut on_walls, mut t) = (0.0, 0.0, 0.0);
+    while t < 0.2 {
+        let dt = world.step().unwrap().dt;
+        on_paddle += world.body(id).unwrap().force().x * dt;
+        on_walls += world.wall_force().x * dt;
+        t += dt;
+    }
+    // The water has not reached the far wall.
+    assert!(world.positions().iter().all(|p| p.x < 1.45));
+    (momentum(&world) - before, on_paddle, on_walls)
+}
+
+#[test]
+fn the_fluid_gains_the_momentum_the_paddle_reports_losing() {
+    let (gained, paddle, walls) = paddle_push(ProjectionWeight::Uniform);
+    assert!(gained > 50.0, "the paddle hardly pushed: {gained} N·s");
+    assert!(walls.abs() < 0.01 * gained, "walls took {walls} N·s");
+    assert!(
+        (gained / -paddle - 1.0).abs() < 0.02,
+        "fluid gained {gained:.2} N·s, paddle reports {paddle:.2} N·s"
+    );
+}
+
+/// With the default weighting the fluid's own forces are not conservative (§2.5, §11.3): the
+/// water gains a few percent more momentum than any boundary gave it.
+#[test]
+fn with_neighbour_count_weights_the_fluid_gains_a_few_percent_more_than_the_paddle_gave() {
+    let (gained, paddle, _) = paddle_push(ProjectionWeight::NeighborCount);
+    let surplus = gained / -paddle - 1.0;
+    assert!(
+        (0.0..0.08).contains(&surplus),
+        "fluid gained {gained:.2} N·s, paddle reports {paddle:.2} N·s"
+    );
+}
+
+/// The built-in scene's boxes of 300, 600 and 900 kg/m³ float with that fraction of their
+/// height under water (averaged over the last second of 5 s, the water still sloshing a
+/// little), and no fluid particle gets past any box's particles.
+#[test]
+fn floating_boxes_settle_at_their_density_ratio() {
+    let scene = Scene::builtin("floating_boxes").unwrap();
+    let mut world = scene.build_world().unwrap();
+    let half = Vec3::new(0.25, 0.15, 0.25);
+    let (mut sums, mut samples) = ([0.0; 3], 0);
+    while world.time() < scene.duration {
+        world.step().unwrap();
+        if world.time() < scene.duration - 1.0 {
+            continue;
+        }
+        // Away from the boxes, which sit along the tank's middle.
+        let surface = level(&world, |p| p.z < 0.25 || p.z > 0.95);
+        for (sum, body) in sums.iter_mut().zip(world.bodies()) {
+            *sum += (surface - (body.centre_of_mass().y - half.y)) / (2.0 * half.y);
+        }
+        samples += 1;
+    }
+    for ((sum, body), density) in sums.iter().zip(world.bodies()).zip([300.0, 600.0, 900.0]) {
+        let fraction = sum / samples as f64;
+        assert!(
+            (fraction - density / RHO0).abs() < 0.05,
+            "the {density} kg/m³ box floats {fraction:.3} under water"
+        );
+        // How far any fluid particle's centre lies inside the box's mesh: at its edges and
+        // corners, which the layer of particles r inside the mesh rounds, the fluid can reach
+        // a little way in; past that layer it would have leaked.
+        let inverse = body.pose().rotation.inverse();
+        let depth = world
+            .positions()
+            .iter()
+            .map(|p| inverse * (p - body.pose().position))
+            .map(|q| (0..3).map(|a| half[a] - q[a].abs()).fold(f64::INFINITY, f64::min))
+            .fold(f64::NEG_INFINITY, f64::max);
+        assert!(
+            depth < R,
+            "a fluid particle is {depth} m inside the {density} kg/m³ box"
+        );
+    }
+}
+
+#[test]
+fn a_box_denser_than_water_sinks_to_the_floor_and_rests_there() {
+    let mut world = World::new(params(ProjectionWeight::NeighborCount)).unwrap();
+    let e = R / 4.0;
+    world
+        .add_container(
+            Aabb {
+                min: Vec3::repeat(-e),
+                max: Vec3::new(0.8 + e, 1.0, 0.8 + e),
+            },
+            1,
+        )
+        .unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(D), [15, 6, 15], Vec3::zeros())
+        .unwrap();
+    let half = Vec3::new(0.15, 0.1, 0.15);
+    let id = world
+        .add_body(box_body(
+            BodyKind::Dynamic,
+            half,
+            Some(1200.0),
+            Vec3::new(0.4, 0.5, 0.4),
+        ))
+        .unwrap();
+    world.advance(2.5).unwrap();
+    let body = world.body(id).unwrap();
+    // It sinks onto the floor (at y = −r/4) and rests there; the last layer of water under it
+    // is not squeezed out, so it stands at most one particle spacing above the floor.
+    let bottom = body.centre_of_mass().y - half.y + e;
+    assert!(bottom < D + 0.5 * R, "the box's bottom is {bottom} m above the floor");
+    assert!(body.velocity().linear.norm() < 0.02, "{:?}", body.velocity());
+    let below = world.positions().iter().filter(|p| p.y < -e).count();
+    assert_eq!(below, 0);
+}

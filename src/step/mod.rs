@@ -103,7 +103,13 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(bodies, containers, params.particle_radius, dt, time);
+    advance_poses(
+        bodies,
+        containers,
+        CONTACT_CLEARANCE * params.particle_radius,
+        dt,
+        time,
+    );
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
@@ -182,7 +188,13 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         ..
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(bodies, containers, params.particle_radius, dt, time);
+    advance_poses(
+        bodies,
+        containers,
+        CONTACT_CLEARANCE * params.particle_radius,
+        dt,
+        time,
+    );
     for body in bodies.iter_mut() {
         body.force = Vec3::zeros();
         body.torque = Vec3::zeros();
@@ -204,6 +216,11 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
     let next_dt = pool.install(|| next_step_size(params, &[], gravity, dt, speed));
     (stats, next_dt)
 }
+
+/// How close (in particle radii r) a dynamic body's particles may come to a container wall:
+/// room for one layer of fluid between them, so that a body landing on the floor cannot
+/// squeeze the last layer of water through the wall (docs/method.md §11.4).
+const CONTACT_CLEARANCE: f64 = 3.0;
 
 /// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s),
 /// keeping each dynamic body's particles at least `clearance` (m) inside the container that

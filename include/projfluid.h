@@ -722,7 +722,8 @@ enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out)
  * Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
  * `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
  *
- * Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite or above 1; no fluid particles;
+ * Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite, above 1, or so short that the
+ * time would not change, e.g. 1e-300; no fluid particles;
  * emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
  * buffers and neighbour lists, reserved before it starts). On any error the world is
  * unchanged.
@@ -736,10 +737,11 @@ enum PfStatus pf_world_step(struct PfWorld *world, double dt);
  * Takes CFL-limited steps until `seconds` more simulated time has passed (the last step
  * is shortened to land exactly). 0 takes no step; otherwise `seconds` must be at least
  * `dt_min` (`PfParams.dt_min`, default 1e-4 s), since a shorter span would not move the
- * clock reliably.
+ * clock reliably, and the run must end before t = 1e12·dt_min (1e8 s by default), beyond
+ * which the clock no longer resolves such a step.
  *
- * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative, not finite, or between 0 and
- * dt_min; no fluid particles; emitters that could exceed the particle limit within
+ * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative, not finite, between 0 and dt_min,
+ * or ending too late; no fluid particles; emitters that could exceed the particle limit within
  * `seconds`), `PF_ERROR_OUT_OF_MEMORY`. The call succeeds or changes nothing: everything is
  * checked, and the storage the steps need (particles the emitters may insert, buffers,
  * neighbour lists for up to 1.25 times the neighbours of fluid at rest) reserved, before

@@ -16,6 +16,10 @@ use crate::step::{StepContext, idle_step, take_step};
 /// density (compressed fluid holds a few per cent more).
 const NEIGHBOR_SLACK: f64 = 1.25;
 
+/// The relative precision to which a duration is kept: steps end within this fraction of
+/// the end time (s) of it, so that rounding never leaves a vanishing last step.
+const CLOCK_RESOLUTION: f64 = 1e-12;
+
 /// Bytes per boundary particle that sorting the boundary and computing its volumes needs
 /// at once (positions, owners, masses, components, order, volumes, cell ranks).
 const BOUNDARY_SORT_BYTES: f64 = 128.0;
@@ -35,10 +39,18 @@ impl World {
     /// it has emitters or had particles removed: time and bodies then move on and the
     /// statistics are zero; otherwise stepping it is an error.
     ///
-    /// Errors, changing nothing: a bad `dt`, no fluid, emitters that would exceed the
-    /// particle limit, or ([`Error::OutOfMemory`]) too little memory for the step.
+    /// Errors, changing nothing: a bad `dt` (or one so short that the clock, at the current
+    /// time, would not move), no fluid, emitters that would exceed the particle limit, or
+    /// ([`Error::OutOfMemory`]) too little memory for the step.
     pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
         check_step("dt", dt)?;
+        if self.time + dt == self.time {
+            return Err(Error::invalid(
+                "dt",
+                dt,
+                &format!("is too short to move the clock at t = {} s", self.time),
+            ));
+        }
         self.prepare_steps(0.0)?;
         Ok(self.take_prepared_step(dt))
     }
@@ -121,7 +133,9 @@ impl World {
     /// Steps until `seconds` more simulated time has passed; the last step is shortened to
     /// land exactly. Returns the number of steps taken. `seconds` is 0 (no step) or at least
     /// `dt_min` ([`crate::Params::dt_min`]): a shorter span would not move the clock
-    /// reliably. Errors, changing nothing: a bad `seconds`, no fluid, emitters that could
+    /// reliably; and the run must end before t = 10¹²·dt_min (10⁸ s by default), beyond
+    /// which the clock no longer resolves such a step. Errors, changing nothing: a bad
+    /// `seconds`, no fluid, emitters that could
     /// exceed the particle limit within `seconds`, or ([`Error::OutOfMemory`]) too little
     /// memory for the steps.
     pub fn advance(&mut self, seconds: f64) -> Result<usize, Error> {
@@ -191,14 +205,16 @@ impl World {
             ));
         }
         let end = self.time + seconds;
-        let landed = |time: f64| end - time <= 1e-12 * end.abs().max(1.0);
-        if landed(self.time) {
+        // Steps land within this of `end`; it must stay below the shortest step.
+        let landed = |time: f64| end - time <= CLOCK_RESOLUTION * end.abs().max(1.0);
+        if CLOCK_RESOLUTION * end.abs() >= dt_min {
             return Err(Error::invalid(
                 "seconds",
                 seconds,
                 &format!(
-                    "is too short to move the clock at t = {} s (it resolves 1e-12 of the time)",
-                    self.time
+                    "would end at t = {end} s, where the clock no longer resolves dt_min = \
+                     {dt_min} s (it must end before {} s)",
+                    dt_min / CLOCK_RESOLUTION
                 ),
             ));
         }

@@ -288,12 +288,16 @@ mod step {
         let dt_min = world.params().dt_min;
         assert_eq!(world.advance(dt_min).unwrap(), 1);
         assert_eq!(world.time(), dt_min);
-        // Far into a run the clock resolves less than dt_min.
+        // Far into a run (or for an absurd span) the clock resolves less than dt_min.
         let mut late = small_dam_break();
+        let message = late.advance(1e300).unwrap_err().to_string();
+        assert!(message.contains("no longer resolves dt_min"), "{message}");
         late.time = 1e9;
         let message = late.advance(dt_min).unwrap_err().to_string();
-        assert!(message.contains("too short to move the clock"), "{message}");
+        assert!(message.contains("no longer resolves dt_min"), "{message}");
         assert_eq!(late.steps(), 0);
+        let message = late.step_with_dt(1e-9).unwrap_err().to_string();
+        assert!(message.contains("too short to move the clock"), "{message}");
     }
 
     /// Parameters that validate can be stepped: time steps above MAX_STEP are refused by

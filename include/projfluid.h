@@ -52,7 +52,8 @@ typedef enum PfStatus {
      */
     PF_ERROR_BUFFER_TOO_SMALL = 3,
     /**
-     * Memory for the world's particle storage could not be allocated.
+     * Memory could not be allocated: for particles, boundaries, meshes, or what the next
+     * steps need (buffers and neighbour lists, reserved before the first step of a call).
      */
     PF_ERROR_OUT_OF_MEMORY = 4,
     /**
@@ -504,7 +505,7 @@ enum PfStatus pf_world_create(const struct PfParams *params,
 /**
  * Frees a world and everything it owns, waiting for its worker threads to exit.
  * NULL is a no-op. The handle must not be used afterwards, nor be in use by another
- * thread during the call.
+ * thread during the call. Returning nothing, it leaves the last error message alone.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create` that is not used again.
@@ -545,7 +546,9 @@ enum PfStatus pf_world_add_fluid_particles_with_velocities(struct PfWorld *world
  * `count` 3 sizes, `velocity` 3 floats (m/s) or NULL for particles at rest.
  *
  * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a zero count, a product
- * above the particle limit, non-finite start or velocity), `PF_ERROR_OUT_OF_MEMORY`.
+ * above the particle limit, non-finite start or velocity), `PF_ERROR_OUT_OF_MEMORY` (the
+ * particles are written straight into storage reserved first). On any error no particle
+ * is added.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `start` and `velocity` must be NULL or point to 3 readable floats, `count` to 3 readable sizes.
@@ -575,7 +578,7 @@ enum PfStatus pf_world_add_boundary_particles(struct PfWorld *world,
  *
  * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
  * shorter than two particle spacings or inverted, layers outside 1–3, a box needing too
- * many particles).
+ * many particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable floats.
@@ -719,7 +722,11 @@ enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out)
  * Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
  * `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
  *
- * Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite or above 1; no fluid particles).
+ * Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite, above 1, or so short that the
+ * time would not change, e.g. 1e-300; no fluid particles;
+ * emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
+ * buffers and neighbour lists, reserved before it starts). On any error the world is
+ * unchanged.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`.
@@ -728,10 +735,18 @@ enum PfStatus pf_world_step(struct PfWorld *world, double dt);
 
 /**
  * Takes CFL-limited steps until `seconds` more simulated time has passed (the last step
- * is shortened to land exactly). 0 takes no step.
+ * is shortened to land exactly). 0 takes no step; otherwise `seconds` must be at least
+ * `dt_min` (`PfParams.dt_min`, default 1e-4 s), since a shorter span would not move the
+ * clock reliably, and the run must end before t = 1e12·dt_min (1e8 s by default), beyond
+ * which the clock no longer resolves such a step.
  *
- * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative or not finite; no fluid particles
- * while seconds > 0).
+ * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative, not finite, between 0 and dt_min,
+ * or ending too late; no fluid particles; emitters that could exceed the particle limit within
+ * `seconds`), `PF_ERROR_OUT_OF_MEMORY`. The call succeeds or changes nothing: everything is
+ * checked, and the storage the steps need (particles the emitters may insert, buffers,
+ * neighbour lists for up to 1.25 times the neighbours of fluid at rest) reserved, before
+ * the first step. Neighbour lists that outgrow that reservation in a strongly compressed
+ * fluid still grow during a step, where running out of memory aborts as in any program.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`.
@@ -745,8 +760,8 @@ enum PfStatus pf_world_advance(struct PfWorld *world, double seconds);
  * on a lattice is not at rest under gravity; 10 s at 4/s bring a tank to its equilibrium
  * packing, from which it stays at rest under the calm settings (`pf_params_calm`).
  *
- * Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds or damping negative or not finite; no fluid
- * particles while seconds > 0), taking no step.
+ * Errors: those of `pf_world_advance`, and `PF_ERROR_INVALID_ARGUMENT` for a damping that
+ * is negative or not finite; on any error no step is taken and the world is unchanged.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`.

@@ -62,6 +62,17 @@ impl Aabb {
 /// edges and corners once. Each extra layer is the same box grown outward by `spacing`.
 pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Vec3> {
     let mut points = Vec::new();
+    sample_box_walls_into(container, spacing, layers, &mut points);
+    points
+}
+
+/// [`sample_box_walls`], appending to `points` (whose capacity the caller may reserve).
+pub(crate) fn sample_box_walls_into(
+    container: &Aabb,
+    spacing: f64,
+    layers: usize,
+    points: &mut Vec<Vec3>,
+) {
     for layer in 0..layers {
         let grow = Vec3::repeat(layer as f64 * spacing);
         let (min, max) = (container.min - grow, container.max + grow);
@@ -86,7 +97,6 @@ pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Ve
             }
         }
     }
-    points
 }
 
 /// Akinci volumes V_b = 1/Σ_{b'} W(x_b − x_b') (self included) for boundary particles

@@ -215,12 +215,6 @@ impl Emitter {
         self.state.spec.end_time.is_none_or(|end| time < end)
     }
 
-    /// An upper bound on the number of layers due at the start of the next step: the whole
-    /// spacings the last layer has travelled.
-    pub(crate) fn layers_due_bound(&self) -> f64 {
-        (self.state.travelled / self.spacing).floor()
-    }
-
     /// Takes the layers due at the start of a step at `time` (s): writes their distances
     /// (m) from the opening along the direction into `offsets`, the oldest (farthest) first.
     /// A layer is due once the one before has travelled d; it is born when that happened and

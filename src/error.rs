@@ -14,6 +14,8 @@ pub enum Error {
     },
     /// A file could not be read or written.
     Io(String),
+    /// Memory for what the message names could not be allocated; nothing was changed.
+    OutOfMemory(String),
 }
 
 impl Error {
@@ -25,13 +27,18 @@ impl Error {
             field,
         }
     }
+
+    /// An out-of-memory error for `what` (e.g. `fluid particles`).
+    pub fn out_of_memory(what: &str) -> Self {
+        Error::OutOfMemory(format!("out of memory while allocating {what}"))
+    }
 }
 
 impl fmt::Display for Error {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Error::InvalidArgument { message, .. } => f.write_str(message),
-            Error::Io(message) => f.write_str(message),
+            Error::Io(message) | Error::OutOfMemory(message) => f.write_str(message),
         }
     }
 }

@@ -31,9 +31,19 @@ impl Fluid {
     /// Appends particles at `positions` (m) with `velocities` (m/s), the densities zero, and
     /// gives them the next ids in order. The caller checked the lengths and values.
     pub fn push(&mut self, positions: &[Vec3], velocities: impl IntoIterator<Item = Vec3>) {
+        self.extend(positions.iter().copied(), velocities);
+    }
+
+    /// [`Fluid::push`] from an iterator of positions (m), as many velocities (m/s) following.
+    pub fn extend(
+        &mut self,
+        positions: impl IntoIterator<Item = Vec3>,
+        velocities: impl IntoIterator<Item = Vec3>,
+    ) {
         let first = self.next_id;
-        let count = positions.len() as u64;
-        self.positions.extend_from_slice(positions);
+        let before = self.positions.len();
+        self.positions.extend(positions);
+        let count = (self.positions.len() - before) as u64;
         self.velocities.extend(velocities);
         self.densities.resize(self.positions.len(), 0.0);
         self.ids.extend(first..first + count);

@@ -30,6 +30,7 @@ pub mod params;
 pub mod pressure;
 mod random;
 pub mod reduce;
+mod reserve;
 pub mod scene;
 mod simd;
 pub mod solver;

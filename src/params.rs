@@ -225,16 +225,36 @@ pub struct Params {
     pub projection_weight: ProjectionWeight,
     /// CFL factor λ in Δt = λ·0.4·2r/v_max.
     pub cfl_factor: f64,
-    /// Smallest time step (s).
+    /// Smallest time step (s), in (0, [`MAX_STEP`]]; also the shortest duration
+    /// [`crate::World::advance`] accepts.
     pub dt_min: f64,
-    /// Largest time step (s).
+    /// Largest time step (s), in [`dt_min`](Params::dt_min), [`MAX_STEP`]].
     pub dt_max: f64,
-    /// Time step of the first step (s).
+    /// Time step of the first step (s), in (0, [`MAX_STEP`]] (clamped to [dt_min, dt_max]).
     pub dt_initial: f64,
     /// XSPH viscosity coefficient c_X (dimensionless, 0 = off).
     pub viscosity: f64,
     /// Worker threads of the world's own pool (0 = one per core).
     pub threads: usize,
+}
+
+/// The longest time step (s) a world takes: the bound on `dt_min`, `dt_max` and
+/// `dt_initial` and on an explicit step's size, checked by one rule ([`check_step`]).
+pub const MAX_STEP: f64 = 1.0;
+
+/// Checks a time step size `dt` (s) named `field`: positive, finite and at most
+/// [`MAX_STEP`]. Both [`Params::validate`] (for `dt_min`, `dt_max`, `dt_initial`) and
+/// [`crate::World::step_with_dt`] use it, so that parameters that validate can be stepped.
+pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
+    if dt.is_finite() && dt > 0.0 && dt <= MAX_STEP {
+        Ok(())
+    } else {
+        Err(crate::Error::invalid(
+            field,
+            dt,
+            &format!("must be a positive finite number of seconds (at most {MAX_STEP})"),
+        ))
+    }
 }
 
 /// Default particle radius (m).

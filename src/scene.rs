@@ -183,6 +183,7 @@ fn prefixed(error: Error, prefix: &str) -> Error {
             message: format!("{prefix}{message}"),
         },
         Error::Io(message) => Error::Io(format!("{prefix}{message}")),
+        Error::OutOfMemory(message) => Error::OutOfMemory(format!("{prefix}{message}")),
     }
 }
 

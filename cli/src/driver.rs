@@ -70,6 +70,9 @@ impl From<RunError<std::convert::Infallible>> for Error {
                     message: format!("step {step} failed: {message}"),
                 },
                 Error::Io(message) => Error::Io(format!("step {step} failed: {message}")),
+                Error::OutOfMemory(message) => {
+                    Error::OutOfMemory(format!("step {step} failed: {message}"))
+                }
             },
             RunError::Callback(never) => match never {},
         }

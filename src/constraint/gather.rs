@@ -30,6 +30,18 @@ pub struct Corrections {
 }
 
 impl Corrections {
+    /// Reserves the per-particle arrays for `particles` fluid particles (the segments of kept
+    /// corrections, few and of unknown size, are not reserved).
+    pub(crate) fn try_reserve(
+        &mut self,
+        particles: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        use crate::reserve::reserve_total;
+        reserve_total(&mut self.lambdas, particles)?;
+        reserve_total(&mut self.moved, particles)?;
+        reserve_total(&mut self.near_kept, particles)
+    }
+
     /// How many projections of the last local step kept their corrections.
     pub fn kept(&self) -> usize {
         self.owners.len()

@@ -21,7 +21,8 @@ pub enum PfStatus {
     PF_ERROR_INVALID_ARGUMENT = 2,
     /// An output buffer was too short; the size needed was written to `*needed`.
     PF_ERROR_BUFFER_TOO_SMALL = 3,
-    /// Memory for the world's particle storage could not be allocated.
+    /// Memory could not be allocated: for particles, boundaries, meshes, or what the next
+    /// steps need (buffers and neighbour lists, reserved before the first step of a call).
     PF_ERROR_OUT_OF_MEMORY = 4,
     /// The library panicked (a bug); the world involved, if any, is now poisoned.
     PF_ERROR_PANIC = 5,
@@ -73,7 +74,12 @@ impl Failure {
 
 impl From<crate::Error> for Failure {
     fn from(e: crate::Error) -> Self {
-        Self::invalid(e.to_string())
+        match e {
+            crate::Error::OutOfMemory(message) => {
+                Self::new(PfStatus::PF_ERROR_OUT_OF_MEMORY, message)
+            }
+            other => Self::invalid(other.to_string()),
+        }
     }
 }
 

@@ -177,6 +177,14 @@ impl CellTable {
         self.cell_start.last().map_or(0, |&n| n as usize)
     }
 
+    /// Reserves the sort's scratch for `points` points.
+    pub(crate) fn try_reserve(
+        &mut self,
+        points: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        crate::reserve::reserve_total(&mut self.ranks, points)
+    }
+
     /// Frees the sort's scratch, for a table that is sorted once and kept (the boundary's).
     pub(crate) fn release_scratch(&mut self) {
         self.ranks = Vec::new();

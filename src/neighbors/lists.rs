@@ -60,6 +60,28 @@ impl NeighborLists {
     pub fn pairs(&self) -> usize {
         self.blocks.iter().map(|(_, found)| found.len()).sum()
     }
+
+    /// Reserves room for a search of `queries` points finding about `per_query` neighbours
+    /// each (more where a block found more last time), so that such a search allocates
+    /// nothing. The lists found so far stay as they are.
+    pub(crate) fn try_reserve(
+        &mut self,
+        queries: usize,
+        per_query: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        use crate::reserve::reserve_total;
+        let blocks = queries.div_ceil(BLOCK);
+        reserve_total(&mut self.blocks, blocks)?;
+        while self.blocks.len() < blocks {
+            self.blocks.push(Default::default());
+        }
+        for (starts, found) in &mut self.blocks[..blocks] {
+            reserve_total(starts, BLOCK + 1)?;
+            let more = found.len() + found.len() / 4;
+            reserve_total(found, more.max(BLOCK.saturating_mul(per_query)))?;
+        }
+        self.coordinates.try_reserve(queries)
+    }
 }
 
 /// Runs `f(i, segment_i, &mut items[i])` in parallel over the CSR segments
@@ -134,6 +156,17 @@ impl PointsByComponent {
     /// True when there are no points.
     pub fn is_empty(&self) -> bool {
         self.x.is_empty()
+    }
+
+    /// Reserves room for `points` points in all.
+    pub(crate) fn try_reserve(
+        &mut self,
+        points: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        for c in [&mut self.x, &mut self.y, &mut self.z] {
+            crate::reserve::reserve_total(c, points)?;
+        }
+        Ok(())
     }
 
     /// Replaces the contents with `points` (m), in one parallel pass.

@@ -1,6 +1,6 @@
 //! Checks of [`Params`]: every field in its range; errors name the field and its value.
 
-use super::Params;
+use super::{Params, check_step};
 use crate::Error;
 
 impl Params {
@@ -13,9 +13,6 @@ impl Params {
             ("stiffness", self.stiffness),
             ("displacement_tolerance", self.displacement_tolerance),
             ("cfl_factor", self.cfl_factor),
-            ("dt_min", self.dt_min),
-            ("dt_max", self.dt_max),
-            ("dt_initial", self.dt_initial),
         ];
         for (name, value) in positive {
             if !(value.is_finite() && value > 0.0) {
@@ -25,6 +22,13 @@ impl Params {
                     "must be a positive finite number",
                 ));
             }
+        }
+        for (name, dt) in [
+            ("dt_min", self.dt_min),
+            ("dt_max", self.dt_max),
+            ("dt_initial", self.dt_initial),
+        ] {
+            check_step(name, dt)?;
         }
         let mass = self.particle_mass();
         if !(mass.is_finite() && mass > 0.0) {

@@ -323,7 +323,7 @@ mod tests {
             ),
             (
                 "\"time\": {\"dt_max\": 0}",
-                "time.dt_max must be a positive finite number, got 0",
+                "time.dt_max must be a positive finite number of seconds (at most 1), got 0",
             ),
             (
                 "\"output\": {\"every\": 0}",

@@ -11,6 +11,41 @@ use crate::neighbors::UniformGrid;
 use crate::params::Params;
 use rayon::prelude::*;
 
+impl StepBuffers {
+    /// Reserves what steps of `fluid` fluid particles need, so that they allocate nothing
+    /// (docs/method.md §1.3): every per-particle buffer, the scratch of the sort, the fluid
+    /// neighbour lists for about `per_query` neighbours per particle (or what each block held
+    /// last time, with a quarter more), the boundary lists' blocks, and δ_k for
+    /// `iterations` outer iterations. What cannot be known before a step — more neighbours
+    /// than that, or the segments of kept corrections — may still grow during it.
+    pub(crate) fn try_reserve(
+        &mut self,
+        fluid: usize,
+        per_query: usize,
+        iterations: usize,
+    ) -> Result<(), std::collections::TryReserveError> {
+        use crate::reserve::reserve_total;
+        for buffer in [
+            &mut self.previous,
+            &mut self.current,
+            &mut self.next,
+            &mut self.rhs,
+        ] {
+            reserve_total(buffer, fluid)?;
+        }
+        reserve_total(&mut self.projections, fluid)?;
+        reserve_total(&mut self.order, fluid)?;
+        reserve_total(&mut self.weights, fluid)?;
+        reserve_total(&mut self.system.diagonal, fluid)?;
+        reserve_total(&mut self.scratch_ids, fluid)?;
+        reserve_total(&mut self.displacements, iterations)?;
+        self.table.try_reserve(fluid)?;
+        self.corrections.try_reserve(fluid)?;
+        self.fluid_lists.try_reserve(fluid, per_query)?;
+        self.boundary_lists.try_reserve(fluid, 0)
+    }
+}
+
 /// The inertial prediction s = x + Δt v + Δt² g (m), into `s` (the buffer of X^(0); the
 /// search keeps a copy by component, which serves where s is read later).
 pub(super) fn predict(

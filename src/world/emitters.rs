@@ -37,24 +37,44 @@ impl World {
         self.emitters.iter().map(|e| e.emitted()).sum()
     }
 
-    /// Inserts every emitter's due layers at the start of a step (emitters in order, each
-    /// layer's free lattice points in lattice order), so that they get the next ids. Errors,
-    /// changing nothing, when they could exceed the particle limit.
-    pub(super) fn emit(&mut self) -> Result<(), Error> {
-        if self.emitters.is_empty() {
-            return Ok(());
-        }
-        let due: f64 = self
-            .emitters
+    /// An upper bound on the particles the emitters insert over steps spanning the next
+    /// `seconds` (s; 0 for one step): every layer due now or after travelling on for that
+    /// long, up to each emitter's end time.
+    pub(super) fn emission_bound(&self, seconds: f64) -> f64 {
+        self.emitters
             .iter()
-            .map(|e| e.layers_due_bound() * e.layer_len() as f64)
-            .sum();
+            .map(|e| {
+                let spec = &e.state().spec;
+                let span = spec
+                    .end_time
+                    .map_or(seconds, |end| (end - self.time).clamp(0.0, seconds));
+                let travelled = e.state().travelled + spec.speed * span;
+                (travelled / self.params.spacing()).floor() * e.layer_len() as f64
+            })
+            .sum()
+    }
+
+    /// Checks that steps spanning the next `seconds` (s; 0 for one step) cannot emit more
+    /// fluid than the particle limit allows, and returns how many particles the world may
+    /// then hold at most.
+    pub(super) fn check_emission(&self, seconds: f64) -> Result<usize, Error> {
+        let due = self.emission_bound(seconds);
         if self.fluid.len() as f64 + due > MAX_PARTICLES as f64 {
             return Err(Error::invalid(
                 "emitters",
                 format!("{due:.3e} particles due"),
                 "would exceed the particle limit",
             ));
+        }
+        Ok(self.fluid.len() + due as usize)
+    }
+
+    /// Inserts every emitter's due layers at the start of a step (emitters in order, each
+    /// layer's free lattice points in lattice order), so that they get the next ids. The
+    /// caller checked the particle limit ([`World::check_emission`]).
+    pub(super) fn emit(&mut self) {
+        if self.emitters.is_empty() {
+            return;
         }
         let (mut offsets, mut blocked, mut points) = (Vec::new(), Vec::new(), Vec::new());
         for emitter in &mut self.emitters {
@@ -70,7 +90,6 @@ impl World {
             self.fluid
                 .push(&points, std::iter::repeat_n(velocity, points.len()));
         }
-        Ok(())
     }
 
     /// Adds a step of `dt` seconds to every emitter's travel.

@@ -4,17 +4,32 @@
 
 use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
-use crate::boundary::{Aabb, WALLS, sample_box_walls};
+use crate::boundary::{Aabb, WALLS, sample_box_walls_into};
 use crate::{Error, Vec3};
 
 /// Most boundary particles one triangle mesh may need (by [`sample_count_bound`]), which also
 /// bounds the sampler's time and memory.
 const MAX_MESH_SAMPLES: f64 = 50e6;
 
+/// Working memory of the Poisson-disk sampler per sample of [`sample_count_bound`] (bytes):
+/// about ten candidates of 32 bytes each, the accepted samples and their cell table.
+const MESH_SAMPLING_BYTES: f64 = 400.0;
+
+/// The error of a fluid reservation that failed.
+fn fluid_oom(_: std::collections::TryReserveError) -> Error {
+    Error::out_of_memory("fluid particles")
+}
+
+/// The error of a boundary reservation that failed.
+fn boundary_oom(_: std::collections::TryReserveError) -> Error {
+    Error::out_of_memory("boundary particles")
+}
+
 impl World {
     /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
     /// They get the next ids in the order given (see [`World::ids`]). Rejects non-finite
-    /// values and length mismatches without changing the world.
+    /// values, length mismatches, too many particles and ([`Error::OutOfMemory`]) a shortage
+    /// of memory without changing the world.
     pub fn add_fluid_particles(
         &mut self,
         positions: &[Vec3],
@@ -38,6 +53,7 @@ impl World {
                 "would exceed the particle limit",
             ));
         }
+        self.try_reserve_fluid(positions.len()).map_err(fluid_oom)?;
         match velocities {
             Some(v) => self.fluid.push(positions, v.iter().copied()),
             None => self.fluid.push(
@@ -50,7 +66,9 @@ impl World {
 
     /// Adds a cubic lattice of fluid particles with spacing 2r: centres at
     /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with `velocity`.
-    /// They get the next ids with i running fastest, then j, then k.
+    /// They get the next ids with i running fastest, then j, then k. Errors, changing
+    /// nothing, on a zero or absurd count, a non-finite lattice, or ([`Error::OutOfMemory`])
+    /// a shortage of memory; the lattice is written straight into the particle storage.
     pub fn add_fluid_block(
         &mut self,
         start: Vec3,
@@ -68,16 +86,30 @@ impl World {
                 ));
             }
         }
-        let d = self.params.spacing();
-        let positions: Vec<Vec3> = (0..count[2])
-            .flat_map(|k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
-            .map(|(i, j, k)| start + Vec3::new(i as f64, j as f64, k as f64) * d)
-            .collect();
+        let n = total.unwrap_or(0);
         check_finite("start", &[start, velocity])?;
-        self.add_fluid_particles(&positions, Some(&vec![velocity; positions.len()]))
+        let d = self.params.spacing();
+        let at =
+            move |i: usize, j: usize, k: usize| start + Vec3::new(i as f64, j as f64, k as f64) * d;
+        // The lattice is monotone along each axis: its far corner is finite only if all are.
+        check_finite("positions", &[at(count[0] - 1, count[1] - 1, count[2] - 1)])?;
+        if self.fluid.len() + n > MAX_PARTICLES {
+            return Err(Error::invalid(
+                "count",
+                format!("{count:?}"),
+                "would exceed the particle limit",
+            ));
+        }
+        self.try_reserve_fluid(n).map_err(fluid_oom)?;
+        let lattice = (0..count[2])
+            .flat_map(|k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
+            .map(move |(i, j, k)| at(i, j, k));
+        self.fluid.extend(lattice, std::iter::repeat_n(velocity, n));
+        Ok(())
     }
 
-    /// Adds static boundary particles at `positions` (m).
+    /// Adds static boundary particles at `positions` (m). Rejects non-finite values, too many
+    /// particles and ([`Error::OutOfMemory`]) a shortage of memory without changing the world.
     pub fn add_boundary_particles(&mut self, positions: &[Vec3]) -> Result<(), Error> {
         check_finite("positions", positions)?;
         if self.boundary.positions.len() + positions.len() > MAX_PARTICLES {
@@ -87,12 +119,16 @@ impl World {
                 "would exceed the boundary particle limit",
             ));
         }
+        self.try_reserve_boundary(positions.len())
+            .map_err(boundary_oom)?;
         self.boundary.add_static(positions, WALLS);
         Ok(())
     }
 
     /// Adds a closed container box: its six walls sampled with boundary particles of spacing r,
-    /// `layers` layers thick (1–3). Fluid outside every container counts as escaped.
+    /// `layers` layers thick (1–3). Fluid outside every container counts as escaped. Errors,
+    /// changing nothing, on a bad box or layer count, too many particles, or a shortage of
+    /// memory.
     pub fn add_container(&mut self, container: Aabb, layers: usize) -> Result<(), Error> {
         check_finite("container", &[container.min, container.max])?;
         let r = self.params.particle_radius;
@@ -126,7 +162,12 @@ impl World {
                 &format!("needs about {expected:.3e} boundary particles, more than the limit"),
             ));
         }
-        let samples = sample_box_walls(&container, r, layers);
+        let mut samples = Vec::new();
+        samples
+            .try_reserve_exact(expected as usize)
+            .map_err(boundary_oom)?;
+        sample_box_walls_into(&container, r, layers, &mut samples);
+        self.containers.try_reserve(1).map_err(boundary_oom)?;
         self.add_boundary_particles(&samples)?;
         self.containers.push(container);
         Ok(())
@@ -161,8 +202,9 @@ impl World {
     /// added as boundary particles. Their Akinci volumes are computed before the next step.
     /// Winding does not matter and the mesh need not be closed; only the surface is sampled,
     /// one layer thick. Errors, leaving the world unchanged, when the mesh is far larger than r
-    /// (an extent above 10⁶·r or more than about 5·10⁷ samples) or the boundary particle
-    /// limit would be exceeded.
+    /// (an extent above 10⁶·r or more than about 5·10⁷ samples), the boundary particle
+    /// limit would be exceeded, or ([`Error::OutOfMemory`]) the memory the sampling needs
+    /// cannot be had when the call starts.
     pub fn add_boundary_mesh(&mut self, mesh: &TriangleMesh) -> Result<(), Error> {
         let r = self.params.particle_radius;
         let bounds = mesh.bounds();
@@ -187,6 +229,7 @@ impl World {
                 ),
             ));
         }
+        crate::reserve::probe(bound * MESH_SAMPLING_BYTES).map_err(boundary_oom)?;
         let samples = sample_poisson_disk(mesh, r);
         self.add_boundary_particles(&samples)
     }

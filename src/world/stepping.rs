@@ -1,11 +1,28 @@
 //! Advancing a world in time: one step, a duration, or a damped relaxation towards rest.
 //! The step itself is [`crate::step`]'s; this is where its size is checked, time kept, and
 //! fluid emitted before it and removed after it (docs/method.md §12).
+//!
+//! A call either succeeds or changes nothing: everything that can fail — the sizes, the
+//! presence of fluid, the particle limit over the emitters' output, the memory the steps
+//! need — is checked before the first step, after which the steps cannot fail.
 
 use super::World;
 use crate::Error;
+use crate::params::check_step;
 use crate::stats::StepStats;
 use crate::step::{StepContext, idle_step, take_step};
+
+/// Neighbours per fluid particle reserved for, as a multiple of the stencil size at rest
+/// density (compressed fluid holds a few per cent more).
+const NEIGHBOR_SLACK: f64 = 1.25;
+
+/// The relative precision to which a duration is kept: steps end within this fraction of
+/// the end time (s) of it, so that rounding never leaves a vanishing last step.
+const CLOCK_RESOLUTION: f64 = 1e-12;
+
+/// Bytes per boundary particle that sorting the boundary and computing its volumes needs
+/// at once (positions, owners, masses, components, order, volumes, cell ranks).
+const BOUNDARY_SORT_BYTES: f64 = 128.0;
 
 impl World {
     /// Takes one step with the CFL-limited step size.
@@ -13,22 +30,34 @@ impl World {
         self.step_with_dt(self.next_dt)
     }
 
-    /// Takes one step of `dt` seconds (positive, finite). The CFL rule still sets the size
-    /// the following [`World::step`] will use.
+    /// Takes one step of `dt` seconds (positive, finite, at most [`crate::params::MAX_STEP`]).
+    /// The CFL rule still sets the size the following [`World::step`] will use.
     ///
     /// Before the step the emitters insert their due layers; after it the particles in a
     /// sink or outside the domain are removed (the step's statistics, and the next Δt, are
     /// those of the step before the removal). A world without fluid particles steps only if
     /// it has emitters or had particles removed: time and bodies then move on and the
     /// statistics are zero; otherwise stepping it is an error.
+    ///
+    /// Errors, changing nothing: a bad `dt` (or one so short that the clock, at the current
+    /// time, would not move), no fluid, emitters that would exceed the particle limit, or
+    /// ([`Error::OutOfMemory`]) too little memory for the step.
     pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
-        if !(dt.is_finite() && dt > 0.0 && dt <= 1.0) {
+        check_step("dt", dt)?;
+        if self.time + dt == self.time {
             return Err(Error::invalid(
                 "dt",
                 dt,
-                "must be a positive finite number of seconds (at most 1)",
+                &format!("is too short to move the clock at t = {} s", self.time),
             ));
         }
+        self.prepare_steps(0.0)?;
+        Ok(self.take_prepared_step(dt))
+    }
+
+    /// Checks that steps spanning the next `seconds` (s; 0 for one step) can be taken and
+    /// reserves the storage they need, changing nothing observable.
+    fn prepare_steps(&mut self, seconds: f64) -> Result<(), Error> {
         if self.fluid_count() == 0 && self.emitters.is_empty() && self.fluid.removed == 0 {
             return Err(Error::invalid(
                 "fluid particles",
@@ -36,7 +65,24 @@ impl World {
                 "must be present before stepping",
             ));
         }
-        self.emit()?;
+        let most = self.check_emission(seconds)?;
+        let oom = |_| Error::out_of_memory("the storage of the time steps");
+        self.try_reserve_fluid(most - self.fluid_count())
+            .map_err(oom)?;
+        let per_query = (self.params.rest_stencil_size() * NEIGHBOR_SLACK).ceil() as usize;
+        self.buffers
+            .try_reserve(most, per_query, self.params.max_outer_iterations)
+            .map_err(oom)?;
+        if self.boundary.dirty {
+            crate::reserve::probe(self.boundary_count() as f64 * BOUNDARY_SORT_BYTES)
+                .map_err(oom)?;
+        }
+        Ok(())
+    }
+
+    /// One step of `dt` seconds, after [`World::prepare_steps`] checked everything.
+    fn take_prepared_step(&mut self, dt: f64) -> &StepStats {
+        self.emit();
         let inflow_speed = self.inflow_speed(self.time + dt);
         let idle = self.fluid_count() == 0;
         let World {
@@ -83,17 +129,23 @@ impl World {
         self.steps += 1;
         self.advance_emitters(dt);
         self.drain();
-        Ok(self.last.insert(stats))
+        self.last.insert(stats)
     }
 
     /// Steps until `seconds` more simulated time has passed; the last step is shortened to
-    /// land exactly. Returns the number of steps taken.
+    /// land exactly. Returns the number of steps taken. `seconds` is 0 (no step) or at least
+    /// `dt_min` ([`crate::Params::dt_min`]): a shorter span would not move the clock
+    /// reliably; and the run must end before t = 10¹²·dt_min (10⁸ s by default), beyond
+    /// which the clock no longer resolves such a step. Errors, changing nothing: a bad
+    /// `seconds`, no fluid, emitters that could
+    /// exceed the particle limit within `seconds`, or ([`Error::OutOfMemory`]) too little
+    /// memory for the steps.
     pub fn advance(&mut self, seconds: f64) -> Result<usize, Error> {
         self.advance_with(seconds, |_| Ok(()))
     }
 
     /// [`World::advance`], calling `each` with the world after every step; an error from
-    /// `each` ends the run there and is returned.
+    /// `each` ends the run there and is returned, the steps taken so far kept.
     pub fn advance_with(
         &mut self,
         seconds: f64,
@@ -107,7 +159,8 @@ impl World {
     /// being a rate (1/s, ≥ 0; 0 is [`World::advance`]). Meant for a settled start: a lattice
     /// of particles is not at rest under gravity (its layers slide into each other's hollows)
     /// and 10 s at 4/s bring a tank to its equilibrium packing (docs/validation.md, "Tank at rest").
-    /// Returns the number of steps taken.
+    /// Returns the number of steps taken. Errors as [`World::advance`], and on a bad
+    /// `damping`, changing nothing.
     pub fn relax(&mut self, seconds: f64, damping: f64) -> Result<usize, Error> {
         if !(damping.is_finite() && damping >= 0.0) {
             return Err(Error::invalid(
@@ -127,8 +180,9 @@ impl World {
         })
     }
 
-    /// Takes CFL-limited steps until `seconds` (≥ 0, finite) more simulated time has passed,
-    /// the last one shortened to land exactly, calling `after(world, Δt)` after every step.
+    /// Takes CFL-limited steps until `seconds` (0, or at least `dt_min`, finite) more
+    /// simulated time has passed, the last one shortened to land exactly, calling
+    /// `after(world, Δt)` after every step. Everything that can fail is checked first.
     fn step_for(
         &mut self,
         seconds: f64,
@@ -141,11 +195,37 @@ impl World {
                 "must be a non-negative finite number",
             ));
         }
+        if seconds == 0.0 {
+            return Ok(0);
+        }
+        let dt_min = self.params.dt_min;
+        if seconds < dt_min {
+            return Err(Error::invalid(
+                "seconds",
+                seconds,
+                &format!("must be 0 or at least dt_min = {dt_min} s"),
+            ));
+        }
         let end = self.time + seconds;
+        // Steps land within this of `end`; it must stay below the shortest step.
+        let landed = |time: f64| end - time <= CLOCK_RESOLUTION * end.abs().max(1.0);
+        if CLOCK_RESOLUTION * end.abs() >= dt_min {
+            return Err(Error::invalid(
+                "seconds",
+                seconds,
+                &format!(
+                    "would end at t = {end} s, where the clock no longer resolves dt_min = \
+                     {dt_min} s (it must end before {} s)",
+                    dt_min / CLOCK_RESOLUTION
+                ),
+            ));
+        }
+        self.prepare_steps(seconds)?;
         let mut steps = 0;
-        while end - self.time > 1e-12 * end.abs().max(1.0) {
+        while !landed(self.time) {
+            // next_dt lies in [dt_min, dt_max] (the CFL rule clamps it), so dt is valid.
             let dt = self.next_dt.min(end - self.time);
-            self.step_with_dt(dt)?;
+            self.take_prepared_step(dt);
             after(self, dt)?;
             steps += 1;
         }

@@ -260,4 +260,107 @@ mod step {
         assert!(error.to_string().contains("probe"));
         assert_eq!(stopped.steps(), 2);
     }
+
+    /// The exact state of a world, compared bit for bit before and after a rejected call.
+    fn fingerprint(world: &World) -> (crate::WorldState, String) {
+        (world.export_state(), world.positions_hash())
+    }
+
+    /// A duration between 0 and dt_min is rejected naming dt_min, as is one the clock cannot
+    /// resolve; dt_min itself steps and moves the clock by exactly it (from t = 0).
+    #[test]
+    fn durations_below_dt_min_are_rejected_unchanged() {
+        let mut world = small_dam_break();
+        let before = fingerprint(&world);
+        for seconds in [
+            1e-13,
+            1e-300,
+            f64::MIN_POSITIVE,
+            0.5 * world.params().dt_min,
+        ] {
+            let message = world.advance(seconds).unwrap_err().to_string();
+            assert!(message.contains("at least dt_min"), "{message}");
+            let message = world.relax(seconds, 1.0).unwrap_err().to_string();
+            assert!(message.contains("at least dt_min"), "{message}");
+            assert!(fingerprint(&world) == before, "{seconds} changed the world");
+        }
+        assert_eq!(world.advance(0.0).unwrap(), 0);
+        let dt_min = world.params().dt_min;
+        assert_eq!(world.advance(dt_min).unwrap(), 1);
+        assert_eq!(world.time(), dt_min);
+        // Far into a run (or for an absurd span) the clock resolves less than dt_min.
+        let mut late = small_dam_break();
+        let message = late.advance(1e300).unwrap_err().to_string();
+        assert!(message.contains("no longer resolves dt_min"), "{message}");
+        late.time = 1e9;
+        let message = late.advance(dt_min).unwrap_err().to_string();
+        assert!(message.contains("no longer resolves dt_min"), "{message}");
+        assert_eq!(late.steps(), 0);
+        let message = late.step_with_dt(1e-9).unwrap_err().to_string();
+        assert!(message.contains("too short to move the clock"), "{message}");
+    }
+
+    /// Parameters that validate can be stepped: time steps above MAX_STEP are refused by
+    /// validation and by an explicit step alike, with the same rule.
+    #[test]
+    fn step_sizes_follow_one_rule_in_validation_and_stepping() {
+        use crate::params::MAX_STEP;
+        for field in ["dt_min", "dt_max", "dt_initial"] {
+            let mut params = Params {
+                dt_min: 1e-4,
+                dt_max: MAX_STEP,
+                dt_initial: MAX_STEP,
+                ..Params::default()
+            };
+            params.validate().unwrap();
+            let too_long = 1.5 * MAX_STEP;
+            match field {
+                "dt_min" => params.dt_min = too_long,
+                "dt_max" => params.dt_max = too_long,
+                _ => params.dt_initial = too_long,
+            }
+            let message = World::new(params).err().unwrap().to_string();
+            assert!(
+                message.contains(field) && message.contains("at most 1"),
+                "{message}"
+            );
+        }
+        let mut world = small_dam_break_with(Params {
+            dt_max: MAX_STEP,
+            dt_initial: MAX_STEP,
+            ..Params::default()
+        });
+        assert_eq!(world.next_dt(), MAX_STEP);
+        let message = world.step_with_dt(1.5 * MAX_STEP).unwrap_err().to_string();
+        assert!(
+            message.contains("dt") && message.contains("at most 1"),
+            "{message}"
+        );
+        world.step().unwrap();
+    }
+
+    /// An advance whose emitters would exceed the particle limit part-way fails before its
+    /// first step, leaving the world exactly as it was; a step alone still works.
+    #[test]
+    fn an_advance_that_would_fail_part_way_changes_nothing() {
+        let mut world = small_dam_break();
+        let spec = crate::EmitterSpec {
+            shape: crate::EmitterShape::Disc { radius: 0.05 },
+            position: Vec3::new(0.1, 0.3, 0.1),
+            direction: Vec3::new(0.0, -1.0, 0.0),
+            speed: 1e6,
+            end_time: None,
+        };
+        world.add_emitter(spec).unwrap();
+        let before = fingerprint(&world);
+        let message = world.advance(1.0).unwrap_err().to_string();
+        assert!(message.contains("particle limit"), "{message}");
+        assert!(fingerprint(&world) == before);
+        let message = world.relax(1.0, 4.0).unwrap_err().to_string();
+        assert!(message.contains("particle limit"), "{message}");
+        assert!(fingerprint(&world) == before);
+        let fluid = world.fluid_count();
+        world.step_with_dt(1e-4).unwrap();
+        assert!(world.fluid_count() >= fluid);
+    }
 }

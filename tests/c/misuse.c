@@ -99,6 +99,12 @@ int main(void) {
     p.dt_min = 0.1;
     bad_params(p, "dt_min");
     p = params;
+    p.dt_max = 2.0; /* more than the longest step a world takes (1 s) */
+    bad_params(p, "dt_max");
+    p = params;
+    p.dt_initial = 1.5;
+    bad_params(p, "dt_initial");
+    p = params;
     p.chebyshev_rho = 1.0;
     bad_params(p, "rho");
     p = params;
@@ -309,6 +315,19 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, -1.0));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, NAN));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 0.01, INFINITY));
+    /* Durations between 0 and dt_min (1e-4 s) would not move the clock reliably. */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, 1e-13));
+    CHECK(strstr(last_msg, "dt_min") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, 1e-300));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 5e-5, 1.0));
+
+    /* Functions returning nothing leave the last message alone, even given NULL. */
+    EXPECT(PF_ERROR_NULL_POINTER, pf_world_time(w, NULL));
+    char kept[512];
+    snprintf(kept, sizeof kept, "%s", pf_last_error_message());
+    pf_world_destroy(NULL);
+    CHECK(strcmp(pf_last_error_message(), kept) == 0);
+    rejected++;
 
     /* Calls after all those failures work normally and clear the message. */
     size_t nb = 0, nb_mesh = 0;

@@ -130,8 +130,9 @@ pub fn water_height(world: &World, tank: &Aabb) -> (f64, f64) {
 pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, Error> {
     let (mut world, tank) = setup.build()?;
     let end = setup.relax + setup.settle + READING_WINDOW;
-    // The relaxation in slices of at most a quarter second, for the progress report.
-    while setup.relax - world.time() > 1e-12 * setup.relax {
+    // The relaxation in slices of at most a quarter second, for the progress report, to
+    // within dt_min (the shortest span a world advances by).
+    while setup.relax - world.time() >= world.params().dt_min {
         world.relax((setup.relax - world.time()).min(0.25), setup.damping)?;
         progress(world.time() / end);
     }

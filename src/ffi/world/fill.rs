@@ -65,11 +65,11 @@ fn check_finite(v: Vec3, what: &str) -> Result<Vec3, Failure> {
 /// A world error whose message starts with the Rust argument name `rust`, renamed to the C
 /// argument name `c` (e.g. `positions[3]` → `xyz[3]`).
 fn renamed(error: crate::Error, rust: &str, c: &str) -> Failure {
-    let text = error.to_string();
-    Failure::invalid(match text.strip_prefix(rust) {
-        Some(rest) => format!("{c}{rest}"),
-        None => text,
-    })
+    let failure = Failure::from(error);
+    match failure.message.strip_prefix(rust) {
+        Some(rest) => Failure::new(failure.status, format!("{c}{rest}")),
+        None => failure,
+    }
 }
 
 /// Adds `count` fluid particles at rest at positions `xyz` (3·count floats: x, y, z per
@@ -130,9 +130,6 @@ fn add_fluid(
         None => None,
     };
     world
-        .try_reserve_fluid(count)
-        .map_err(|_| Failure::out_of_memory("fluid particles"))?;
-    world
         .add_fluid_particles(&positions, velocities.as_deref())
         .map_err(|e| renamed(e, "positions", "xyz"))
 }
@@ -143,7 +140,9 @@ fn add_fluid(
 /// `count` 3 sizes, `velocity` 3 floats (m/s) or NULL for particles at rest.
 ///
 /// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a zero count, a product
-/// above the particle limit, non-finite start or velocity), `PF_ERROR_OUT_OF_MEMORY`.
+/// above the particle limit, non-finite start or velocity), `PF_ERROR_OUT_OF_MEMORY` (the
+/// particles are written straight into storage reserved first). On any error no particle
+/// is added.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `start` and `velocity` must be NULL or point to 3 readable floats, `count` to 3 readable sizes.
@@ -166,12 +165,6 @@ pub unsafe extern "C" fn pf_world_add_fluid_box(
         } else {
             check_finite(read_vec3(args, velocity, "velocity")?, "velocity")?
         };
-        let total = counts.iter().try_fold(1usize, |a, &c| a.checked_mul(c));
-        if let Some(n) = total.filter(|&n| n > 0 && n <= MAX_PARTICLES_PER_CALL) {
-            world
-                .try_reserve_fluid(n)
-                .map_err(|_| Failure::out_of_memory("fluid particles"))?;
-        }
         world.add_fluid_block(start, counts, velocity)?;
         Ok(())
     })
@@ -197,9 +190,6 @@ pub unsafe extern "C" fn pf_world_add_boundary_particles(
         check_count(count)?;
         let positions = read_vectors(args, xyz, count, "xyz")?;
         world
-            .try_reserve_boundary(count)
-            .map_err(|_| Failure::out_of_memory("boundary particles"))?;
-        world
             .add_boundary_particles(&positions)
             .map_err(|e| renamed(e, "positions", "xyz"))
     })
@@ -211,7 +201,7 @@ pub unsafe extern "C" fn pf_world_add_boundary_particles(
 ///
 /// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
 /// shorter than two particle spacings or inverted, layers outside 1–3, a box needing too
-/// many particles).
+/// many particles), `PF_ERROR_OUT_OF_MEMORY`. On any error no particle is added.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable floats.

@@ -4,7 +4,7 @@
 
 use super::checked::Args;
 use super::params::PfParams;
-use super::status::{Failure, PfStatus, status_call};
+use super::status::{Failure, PfStatus, call, status_call};
 use crate::{Params, World};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
 use std::thread::JoinHandle;
@@ -135,7 +135,7 @@ pub unsafe extern "C" fn pf_world_create(
 
 /// Frees a world and everything it owns, waiting for its worker threads to exit.
 /// NULL is a no-op. The handle must not be used afterwards, nor be in use by another
-/// thread during the call.
+/// thread during the call. Returning nothing, it leaves the last error message alone.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create` that is not used again.
@@ -143,7 +143,8 @@ pub unsafe extern "C" fn pf_world_create(
 pub unsafe extern "C" fn pf_world_destroy(world: *mut PfWorld) {
     // SAFETY: the caller keeps the contract above.
     let args = unsafe { Args::trusted() };
-    let _ = status_call("pf_world_destroy", || {
+    // `call`, not `status_call`: only status-returning calls clear the message.
+    let _ = call("pf_world_destroy", || {
         if let Some(world) = args.take_world(world) {
             world.shutdown();
         }

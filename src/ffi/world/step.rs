@@ -8,7 +8,11 @@ use crate::ffi::status::{Failure, PfStatus, status_call};
 /// Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
 /// `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
 ///
-/// Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite or above 1; no fluid particles).
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite, above 1, or so short that the
+/// time would not change, e.g. 1e-300; no fluid particles;
+/// emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
+/// buffers and neighbour lists, reserved before it starts). On any error the world is
+/// unchanged.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.
@@ -33,10 +37,18 @@ pub unsafe extern "C" fn pf_world_step(world: *mut PfWorld, dt: f64) -> PfStatus
 }
 
 /// Takes CFL-limited steps until `seconds` more simulated time has passed (the last step
-/// is shortened to land exactly). 0 takes no step.
+/// is shortened to land exactly). 0 takes no step; otherwise `seconds` must be at least
+/// `dt_min` (`PfParams.dt_min`, default 1e-4 s), since a shorter span would not move the
+/// clock reliably, and the run must end before t = 1e12·dt_min (1e8 s by default), beyond
+/// which the clock no longer resolves such a step.
 ///
-/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative or not finite; no fluid particles
-/// while seconds > 0).
+/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative, not finite, between 0 and dt_min,
+/// or ending too late; no fluid particles; emitters that could exceed the particle limit within
+/// `seconds`), `PF_ERROR_OUT_OF_MEMORY`. The call succeeds or changes nothing: everything is
+/// checked, and the storage the steps need (particles the emitters may insert, buffers,
+/// neighbour lists for up to 1.25 times the neighbours of fluid at rest) reserved, before
+/// the first step. Neighbour lists that outgrow that reservation in a strongly compressed
+/// fluid still grow during a step, where running out of memory aborts as in any program.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.
@@ -57,8 +69,8 @@ pub unsafe extern "C" fn pf_world_advance(world: *mut PfWorld, seconds: f64) -> 
 /// on a lattice is not at rest under gravity; 10 s at 4/s bring a tank to its equilibrium
 /// packing, from which it stays at rest under the calm settings (`pf_params_calm`).
 ///
-/// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds or damping negative or not finite; no fluid
-/// particles while seconds > 0), taking no step.
+/// Errors: those of `pf_world_advance`, and `PF_ERROR_INVALID_ARGUMENT` for a damping that
+/// is negative or not finite; on any error no step is taken and the world is unchanged.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.

@@ -50,6 +50,8 @@ impl World {
                 ),
             ));
         }
+        crate::reserve::probe(bound * super::fill::MESH_SAMPLING_BYTES)
+            .map_err(|_| Error::out_of_memory("body particles"))?;
         let on_surface = sample_poisson_disk(&spec.mesh, r);
         let samples = self.pool.install(|| inset(&spec.mesh, &on_surface, r));
         let id = self.bodies.len();

@@ -13,7 +13,7 @@ const MAX_MESH_SAMPLES: f64 = 50e6;
 
 /// Working memory of the Poisson-disk sampler per sample of [`sample_count_bound`] (bytes):
 /// about ten candidates of 32 bytes each, the accepted samples and their cell table.
-const MESH_SAMPLING_BYTES: f64 = 400.0;
+pub(super) const MESH_SAMPLING_BYTES: f64 = 400.0;
 
 /// The error of a fluid reservation that failed.
 fn fluid_oom(_: std::collections::TryReserveError) -> Error {

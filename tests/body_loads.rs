@@ -275,13 +275,14 @@ fn a_box_denser_than_water_sinks_to_the_floor_and_rests_there() {
     world.advance(0.5).unwrap();
     let rested = bottom(&world);
     // The last layer of water under it is not squeezed out: it stands on at most one layer of
-    // particles, and stays there (its velocity flickers from step to step, its place does not).
+    // particles, and stays there within r/4 as the film under it settles (its velocity
+    // flickers from step to step, its place does not).
     assert!(
         rested < 1.5 * D,
         "the box's bottom is {rested} m above the floor"
     );
     assert!(
-        (rested - landed).abs() < 0.002,
+        (rested - landed).abs() < 0.25 * R,
         "the box moved from {landed} m to {rested} m"
     );
     let below = world.positions().iter().filter(|p| p.y < -e).count();

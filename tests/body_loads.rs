@@ -240,9 +240,8 @@ fn floating_boxes_settle_at_their_density_ratio() {
     }
 }
 
-/// A box of 1,200 kg/m³ dropped into water sinks to the floor and stays there. The tank's walls
-/// are two layers thick: with one, the box landing at 1.4 m/s pressed a particle of the water
-/// under it through the floor (as a jet does in the `fountain` scene).
+/// A box of 1,200 kg/m³ dropped into water sinks to the floor and stays there, and the water it
+/// lands on stays in the tank.
 #[test]
 fn a_box_denser_than_water_sinks_to_the_floor_and_rests_there() {
     let mut world = World::new(params(ProjectionWeight::NeighborCount)).unwrap();
@@ -253,7 +252,7 @@ fn a_box_denser_than_water_sinks_to_the_floor_and_rests_there() {
                 min: Vec3::repeat(-e),
                 max: Vec3::new(0.8 + e, 1.0, 0.8 + e),
             },
-            2,
+            1,
         )
         .unwrap();
     world
@@ -271,19 +270,18 @@ fn a_box_denser_than_water_sinks_to_the_floor_and_rests_there() {
     // Its bottom above the floor (at y = −r/4), m.
     let bottom = |w: &World| w.body(id).unwrap().centre_of_mass().y - half.y + e;
     world.advance(2.0).unwrap();
-    let landed = bottom(&world);
-    world.advance(0.5).unwrap();
-    let rested = bottom(&world);
-    // The last layer of water under it is not squeezed out: it stands on at most one layer of
-    // particles, and stays there within r/4 as the film under it settles (its velocity
-    // flickers from step to step, its place does not).
+    // The contact with the floor keeps its mesh 3r above the floor's particles, room for one
+    // layer of water, on which it then rests: over the next 0.5 s it stays less than r above
+    // the contact (its velocity flickers from step to step as that layer settles).
+    let (mut low, mut high) = (f64::INFINITY, f64::NEG_INFINITY);
+    while world.time() < 2.5 {
+        world.step().unwrap();
+        low = low.min(bottom(&world));
+        high = high.max(bottom(&world));
+    }
     assert!(
-        rested < 1.5 * D,
-        "the box's bottom is {rested} m above the floor"
-    );
-    assert!(
-        (rested - landed).abs() < 0.25 * R,
-        "the box moved from {landed} m to {rested} m"
+        low > 3.0 * R - 1e-9 && high < 4.0 * R,
+        "the box's bottom moved between {low} m and {high} m above the floor"
     );
     let below = world.positions().iter().filter(|p| p.y < -e).count();
     assert_eq!(below, 0);

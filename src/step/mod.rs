@@ -220,7 +220,7 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
 /// How close (in particle radii r) a dynamic body's particles may come to a container wall:
 /// room for one layer of fluid between them, so that a body landing on the floor cannot
 /// squeeze the last layer of water through the wall (docs/method.md §11.4).
-const CONTACT_CLEARANCE: f64 = 3.0;
+const CONTACT_CLEARANCE: f64 = 4.0;
 
 /// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s),
 /// keeping each dynamic body's particles at least `clearance` (m) inside the container that

@@ -108,18 +108,25 @@ fn a_box_held_half_under_water_feels_the_weight_of_the_water_it_displaces() {
     );
 }
 
-/// With the uniform projection weight the fluid's own forces conserve momentum (§2.5), so
-/// whatever holds the water up is the walls and the box: together they carry its weight.
+/// The walls and the box together carry the settled water's weight: the box is pushed up by
+/// its buoyancy and pushes the water down as much, so the floor carries weight plus buoyancy.
+/// The walls' load closes the fluid's momentum balance (§11.3), so this checks that the water
+/// has settled and that the box's load is booked once, with its sign.
 #[test]
 fn the_walls_carry_the_weight_of_the_water_and_the_push_of_the_held_box() {
-    let (mut world, id, _, _) = held_box(ProjectionWeight::Uniform);
+    let (mut world, id, half, centre) = held_box(ProjectionWeight::NeighborCount);
     let (up, walls) = mean_loads(&mut world, id, 100);
     let weight = world.fluid_count() as f64 * world.particle_mass() * G;
-    assert!(up > 0.0);
-    // The water pushes the box up and the floor down; the box pushes back on the water.
-    let carried = -walls - up;
+    let far =
+        |p: &Vec3| (p.x - centre.x).abs() > half + 0.05 || (p.z - centre.z).abs() > half + 0.05;
+    let submerged = level(&world, far) - (centre.y - half);
+    let archimedes = RHO0 * G * (2.0 * half).powi(2) * submerged;
     assert!(
-        (carried / weight - 1.0).abs() < 0.02,
+        (-walls / (weight + archimedes) - 1.0).abs() < 0.02,
+        "walls {walls:.1} N for water weighing {weight:.1} N and a buoyancy of {archimedes:.1} N"
+    );
+    assert!(
+        (-walls - up - weight).abs() < 0.02 * weight,
         "walls {walls:.1} N and box {up:.1} N for water weighing {weight:.1} N"
     );
 }

@@ -1,4 +1,4 @@
-//! The fluid's loads on the boundary (docs/method.md §11.3).
+//! The fluid's loads on the bodies and the walls (docs/method.md §11.3).
 //!
 //! A step moves every fluid particle from its prediction s to x^{n+1}, and the outer iteration
 //! says exactly how: each global step is affine in the iterate, X̃_j − s_j =
@@ -6,11 +6,13 @@
 //! combination of iterates. The only terms of Σ_i c_{i,j} that come from boundary particles
 //! are those of particle j's own constraint: its centre correction λ_j w_j ∇_{x_j}C_j has the
 //! boundary part λ_j w_j (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b). So the part u_{j,o} of the displacement
-//! x_j − s_j that the particles of owner o caused follows the same recurrence, with those terms
+//! x_j − s_j that the particles of body o caused follows the same recurrence, with those terms
 //! alone as its source; it is carried along the iteration in one slot per fluid particle and
-//! owner in reach. The owner's load is the opposite of the momentum it gave the fluid:
+//! body in reach. The body's load is the opposite of the momentum it gave the fluid:
 //! F_o = −(m/Δt²) Σ_j u_{j,o}, its moment about the origin Σ_j x_j × f_{j,o} (each pair force
-//! lies on the line through the two particles, so x_j is as good an arm as x_b).
+//! lies on the line through the two particles, so x_j is as good an arm as x_b). The walls and
+//! obstacles take the rest of what the fluid exchanged, K − Σ_o F_o with
+//! K = −(m/Δt²) Σ_j (x_j − s_j).
 //!
 //! Slots are listed in particle order and summed in blocks of fixed size in block order, so
 //! the loads do not depend on the thread count.
@@ -18,7 +20,7 @@
 use crate::Vec3;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Projection};
-use crate::neighbors::NeighborLists;
+use crate::neighbors::{NeighborLists, PointsByComponent};
 use crate::solver::Chebyshev;
 use rayon::prelude::*;
 
@@ -46,13 +48,13 @@ impl Load {
     }
 }
 
-/// The boundary's share of the fluid's displacement, per fluid particle and owner in reach,
-/// at the last three iterates of the outer iteration (m).
+/// The bodies' share of the fluid's displacement, per fluid particle and body in reach, at
+/// the last three iterates of the outer iteration (m).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Coupling {
     /// The fluid particle of each slot.
     particle: Vec<u32>,
-    /// The owner of each slot: body o, or the number of bodies for the walls and obstacles.
+    /// The body of each slot.
     owner: Vec<u32>,
     /// (1/ρ0) Σ_b ψ_b ∇W(s_j − x_b) over the owner's particles b near the slot's particle j,
     /// at the prediction s (1/m): the step moves the fluid far less than a kernel radius, so
@@ -60,6 +62,10 @@ pub(crate) struct Coupling {
     gradient: Vec<Vec3>,
     /// The same over all boundary particles near j (1/m).
     all: Vec<Vec3>,
+    /// Δt²k n_j / Â_jj: how much of the share the global step keeps.
+    keep: Vec<f64>,
+    /// Δt²k w_j / Â_jj (kg⁰): how much of λ_j·gradient it adds (1/m² · m³ = m).
+    gain: Vec<f64>,
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,
@@ -86,7 +92,7 @@ pub(super) struct Iterate<'a> {
 
 impl Coupling {
     /// Starts a step at the prediction `s` (m): one slot, set to zero, for every fluid
-    /// particle and every owner of a boundary particle in its reach.
+    /// particle and every body with a boundary particle in its reach.
     pub fn start(
         &mut self,
         constraint: &DensityConstraint,
@@ -106,7 +112,12 @@ impl Coupling {
                     constraint.kernel.grad_w(&(s[j] - boundary.positions[k]))
                         * (boundary.psi[k] / constraint.rest_density)
                 };
-                let mut owners: Vec<u32> = near.iter().map(|&k| owner_of(k)).collect();
+                // The walls' load is what the bodies leave of the fluid's momentum balance.
+                let mut owners: Vec<u32> = near
+                    .iter()
+                    .map(|&k| owner_of(k))
+                    .filter(|&o| (o as usize) < bodies)
+                    .collect();
                 owners.sort_unstable();
                 owners.dedup();
                 let all: Vec3 = near.iter().map(|&k| gradient(k)).sum();
@@ -136,15 +147,33 @@ impl Coupling {
         }
     }
 
+    /// Takes the global step's coefficients for every slot, once the step's system is set up.
+    pub(super) fn prepare(&mut self, it: &Iterate) {
+        let (fluid_lists, constraint) = (it.fluid_lists, it.constraint);
+        let coefficients = |j: usize| {
+            let scale = it.dt2k / it.diagonal[j];
+            (
+                constraint.membership(fluid_lists, j) * scale,
+                it.weights[j] * scale,
+            )
+        };
+        self.keep.clear();
+        self.gain.clear();
+        for &j in &self.particle {
+            let (keep, gain) = coefficients(j as usize);
+            self.keep.push(keep);
+            self.gain.push(gain);
+        }
+    }
+
     /// Follows one outer iteration: the shares at X^(k+1) from those at X^(k) and X^(k−1)
     /// and the boundary's corrections at X^(k).
     pub(super) fn update(&mut self, it: &Iterate) {
         let (current, previous) = (&self.current, &self.previous);
         self.next.par_iter_mut().enumerate().for_each(|(s, next)| {
             let j = self.particle[s] as usize;
-            let source = it.boundary_correction(j, &self.gradient[s], &self.all[s]);
-            let members = it.constraint.membership(it.fluid_lists, j);
-            let plain = (current[s] * members + source) * (it.dt2k / it.diagonal[j]);
+            let lambda = it.multiplier(j, &self.all[s]);
+            let plain = current[s] * self.keep[s] + self.gradient[s] * (self.gain[s] * lambda);
             *next = match it.chebyshev {
                 Some((chebyshev, omega)) => {
                     chebyshev.extrapolated(omega, plain, current[s], previous[s])
@@ -156,9 +185,18 @@ impl Coupling {
         std::mem::swap(&mut self.current, &mut self.next);
     }
 
-    /// The loads of the step that ended at `x` (m) with step size `dt` (s) on every owner:
-    /// `out[o]` for body o and `out[bodies]` for the walls and obstacles.
-    pub fn loads(&self, mass: f64, x: &[Vec3], dt: f64, out: &mut Vec<Load>) {
+    /// The loads of the step that moved the fluid from the prediction `s` to `x` (m) with
+    /// step size `dt` (s), for particles of mass `mass` (kg): `out[o]` for body o, and
+    /// `out[bodies]` for the walls and obstacles, which take the rest of the momentum the
+    /// fluid exchanged in the step, K = −(m/Δt²) Σ_j (x_j − s_j), and of its moment.
+    pub fn loads(
+        &self,
+        mass: f64,
+        s: &PointsByComponent,
+        x: &[Vec3],
+        dt: f64,
+        out: &mut Vec<Load>,
+    ) {
         let scale = -mass / (dt * dt);
         let bodies = self.bodies;
         let partial: Vec<Vec<Load>> = self
@@ -166,16 +204,31 @@ impl Coupling {
             .par_chunks(BLOCK)
             .enumerate()
             .map(|(block, shares)| {
-                let mut sums = vec![Load::default(); bodies + 1];
-                for (s, u) in (block * BLOCK..).zip(shares) {
+                let mut sums = vec![Load::default(); bodies];
+                for (slot, u) in (block * BLOCK..).zip(shares) {
                     let force = u * scale;
-                    let arm = x[self.particle[s] as usize];
-                    sums[self.owner[s] as usize].add(&Load {
+                    let arm = x[self.particle[slot] as usize];
+                    sums[self.owner[slot] as usize].add(&Load {
                         force,
                         moment: arm.cross(&force),
                     });
                 }
                 sums
+            })
+            .collect();
+        let exchanged: Vec<Load> = x
+            .par_chunks(BLOCK)
+            .enumerate()
+            .map(|(block, xs)| {
+                let mut sum = Load::default();
+                for (j, xj) in (block * BLOCK..).zip(xs) {
+                    let force = (xj - s.at(j)) * scale;
+                    sum.add(&Load {
+                        force,
+                        moment: xj.cross(&force),
+                    });
+                }
+                sum
             })
             .collect();
         out.clear();
@@ -185,39 +238,42 @@ impl Coupling {
                 o.add(s);
             }
         }
+        let mut walls = Load::default();
+        for e in &exchanged {
+            walls.add(e);
+        }
+        for body in &out[..bodies] {
+            walls.force -= body.force;
+            walls.moment -= body.moment;
+        }
+        out[bodies] = walls;
     }
 }
 
 impl Iterate<'_> {
-    /// The part of constraint j's correction of its own particle that the boundary particles
-    /// of one owner cause: λ_j w_j g (m), where g = (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b) over them
-    /// (`of_owner`) and `all` the same over every boundary particle near j (1/m).
-    fn boundary_correction(&self, j: usize, of_owner: &Vec3, all: &Vec3) -> Vec3 {
+    /// λ_j of constraint j's projection at X^(k) (m²; 0 when inactive): the boundary particles
+    /// of an owner corrected particle j by λ_j w_j g, g = (1/ρ0) Σ_b ψ_b ∇W(x_j − x_b) over
+    /// them. `all` is g over every boundary particle near j (1/m).
+    fn multiplier(&self, j: usize, all: &Vec3) -> f64 {
         let p = &self.projections[j];
-        if p.self_correction == Vec3::zeros() {
-            return Vec3::zeros();
+        if !p.materialized {
+            return p.lambda;
         }
-        let w_j = self.weights[j];
-        let lambda = if p.materialized {
-            // Several projection steps: the multiplier that gives the whole correction of the
-            // centre along the gradient at x.
-            let c = self.constraint;
-            let xj = self.x[j];
-            let fluid: Vec3 = self
-                .fluid_lists
-                .of(j)
-                .iter()
-                .map(|&i| c.kernel.grad_w(&(xj - self.x[i as usize])) * (c.mass / c.rest_density))
-                .sum();
-            let gradient = all + fluid;
-            let g2 = gradient.norm_squared() * w_j;
-            if g2 == 0.0 {
-                return Vec3::zeros();
-            }
-            p.self_correction.dot(&gradient) / g2
-        } else {
-            p.lambda
-        };
-        of_owner * (lambda * w_j)
+        // Several projection steps: the multiplier that gives the whole correction of the
+        // centre along the gradient at x.
+        let c = self.constraint;
+        let xj = self.x[j];
+        let fluid: Vec3 = self
+            .fluid_lists
+            .of(j)
+            .iter()
+            .map(|&i| c.kernel.grad_w(&(xj - self.x[i as usize])) * (c.mass / c.rest_density))
+            .sum();
+        let gradient = all + fluid;
+        let g2 = gradient.norm_squared() * self.weights[j];
+        if g2 == 0.0 {
+            return 0.0;
+        }
+        p.self_correction.dot(&gradient) / g2
     }
 }

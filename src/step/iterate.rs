@@ -77,6 +77,18 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     let single_sweep = solver.single_diagonal_sweep();
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
     b.displacements.clear();
+    if couple {
+        b.coupling.prepare(&couple::Iterate {
+            constraint,
+            fluid_lists: &b.fluid_lists,
+            x: &b.current,
+            projections: &b.projections,
+            weights: &b.weights,
+            diagonal: &b.system.diagonal,
+            dt2k,
+            chebyshev: None,
+        });
+    }
     while outer < params.max_outer_iterations {
         let t = Instant::now();
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);

@@ -144,9 +144,10 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         );
         if couple {
             let loads = &mut buffers.loads;
+            let predicted = buffers.fluid_lists.searched_points();
             buffers
                 .coupling
-                .loads(constraint.mass, &buffers.current, dt, loads);
+                .loads(constraint.mass, predicted, &buffers.current, dt, loads);
             for (body, load) in bodies.iter_mut().zip(loads.iter()) {
                 body.force = load.force;
                 body.torque = load.torque_about(&body.centre_of_mass());

@@ -30,7 +30,7 @@ const CLEARANCE_TOLERANCE: f64 = 1e-6;
 ///
 /// Cost: each sample looks only at the triangles near it (a grid of cells of 3·`depth`).
 pub(crate) fn inset(mesh: &TriangleMesh, samples: &[Vec3], depth: f64) -> Vec<Vec3> {
-    if !(depth > 0.0) || !is_closed_and_oriented(mesh) {
+    if depth.is_nan() || depth <= 0.0 || !is_closed_and_oriented(mesh) {
         return samples.to_vec();
     }
     let outward = if signed_volume(mesh) >= 0.0 {
@@ -93,7 +93,7 @@ fn inward_offset(normals: &[Vec3]) -> Option<Vec3> {
             let rhs: Vec3 = -normals.iter().sum::<Vec3>();
             let delta = ntn.svd(true, true).solve(&rhs, 1e-9).ok()?;
             let len = delta.norm();
-            if !(len > 0.0) {
+            if len.is_nan() || len <= 0.0 {
                 return Some(-normals[0]);
             }
             Some(delta * (len.min(MAX_STRETCH) / len))

@@ -82,10 +82,6 @@ pub(super) struct Iterate<'a> {
     pub projections: &'a [Projection],
     /// Projection weights w_j.
     pub weights: &'a [f64],
-    /// Â_jj = m + Δt²k n_j (kg).
-    pub diagonal: &'a [f64],
-    /// Δt²k (kg).
-    pub dt2k: f64,
     /// Chebyshev's recurrence and weight ω, when the step's extrapolation changes the iterate.
     pub chebyshev: Option<(&'a Chebyshev, f64)>,
 }
@@ -147,22 +143,25 @@ impl Coupling {
         }
     }
 
-    /// Takes the global step's coefficients for every slot, once the step's system is set up.
-    pub(super) fn prepare(&mut self, it: &Iterate) {
-        let (fluid_lists, constraint) = (it.fluid_lists, it.constraint);
-        let coefficients = |j: usize| {
-            let scale = it.dt2k / it.diagonal[j];
-            (
-                constraint.membership(fluid_lists, j) * scale,
-                it.weights[j] * scale,
-            )
-        };
+    /// Takes the global step's coefficients Δt²k n_j/Â_jj and Δt²k w_j/Â_jj for every slot,
+    /// once the step's system (`diagonal` Â_jj, kg) and projection `weights` are set up;
+    /// `dt2k` is Δt²k (kg).
+    pub(super) fn prepare(
+        &mut self,
+        constraint: &DensityConstraint,
+        fluid_lists: &NeighborLists,
+        weights: &[f64],
+        diagonal: &[f64],
+        dt2k: f64,
+    ) {
         self.keep.clear();
         self.gain.clear();
         for &j in &self.particle {
-            let (keep, gain) = coefficients(j as usize);
-            self.keep.push(keep);
-            self.gain.push(gain);
+            let j = j as usize;
+            let scale = dt2k / diagonal[j];
+            self.keep
+                .push(constraint.membership(fluid_lists, j) * scale);
+            self.gain.push(weights[j] * scale);
         }
     }
 

@@ -78,16 +78,9 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
     b.displacements.clear();
     if couple {
-        b.coupling.prepare(&couple::Iterate {
-            constraint,
-            fluid_lists: &b.fluid_lists,
-            x: &b.current,
-            projections: &b.projections,
-            weights: &b.weights,
-            diagonal: &b.system.diagonal,
-            dt2k,
-            chebyshev: None,
-        });
+        let (lists, diagonal) = (&b.fluid_lists, &b.system.diagonal);
+        b.coupling
+            .prepare(constraint, lists, &b.weights, diagonal, dt2k);
     }
     while outer < params.max_outer_iterations {
         let t = Instant::now();
@@ -107,8 +100,6 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
                 x: &b.current,
                 projections: &b.projections,
                 weights: &b.weights,
-                diagonal: &b.system.diagonal,
-                dt2k,
                 chebyshev: extrapolation,
             });
         }

@@ -103,13 +103,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(
-        bodies,
-        containers,
-        CONTACT_CLEARANCE * params.particle_radius,
-        dt,
-        time,
-    );
+    advance_poses(bodies, containers, params.particle_radius, dt, time);
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
@@ -189,13 +183,7 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         ..
     } = ctx;
     let gravity = Vec3::from(params.gravity);
-    advance_poses(
-        bodies,
-        containers,
-        CONTACT_CLEARANCE * params.particle_radius,
-        dt,
-        time,
-    );
+    advance_poses(bodies, containers, params.particle_radius, dt, time);
     for body in bodies.iter_mut() {
         body.force = Vec3::zeros();
         body.torque = Vec3::zeros();
@@ -224,9 +212,10 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
 const CONTACT_CLEARANCE: f64 = 4.0;
 
 /// Moves every body to its pose at the end of a step of `dt` seconds that starts at `time` (s),
-/// keeping each dynamic body's particles at least `clearance` (m) inside the container that
-/// holds its centre of mass.
-fn advance_poses(bodies: &mut [Body], containers: &[Aabb], clearance: f64, dt: f64, time: f64) {
+/// keeping each dynamic body's particles at least [`CONTACT_CLEARANCE`] particle radii `r` (m)
+/// inside the container that holds its centre of mass.
+fn advance_poses(bodies: &mut [Body], containers: &[Aabb], r: f64, dt: f64, time: f64) {
+    let clearance = CONTACT_CLEARANCE * r;
     for body in bodies.iter_mut() {
         body.advance_pose(dt, time + dt);
         let centre = body.centre_of_mass();

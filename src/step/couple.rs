@@ -103,28 +103,36 @@ impl Coupling {
             .into_par_iter()
             .flat_map_iter(|j| {
                 let near = boundary_lists.of(j);
-                let gradient = move |k: u32| {
+                // Most particles near a boundary touch only walls: they get no slot (the walls'
+                // load is what the bodies leave of the fluid's momentum balance).
+                let touches_body = |k: &u32| (owner_of(*k) as usize) < bodies;
+                if !near.iter().any(touches_body) {
+                    return Vec::new();
+                }
+                let gradient = |k: u32| {
                     let k = k as usize;
                     constraint.kernel.grad_w(&(s[j] - boundary.positions[k]))
                         * (boundary.psi[k] / constraint.rest_density)
                 };
-                // The walls' load is what the bodies leave of the fluid's momentum balance.
                 let mut owners: Vec<u32> = near
                     .iter()
+                    .filter(|k| touches_body(k))
                     .map(|&k| owner_of(k))
-                    .filter(|&o| (o as usize) < bodies)
                     .collect();
                 owners.sort_unstable();
                 owners.dedup();
                 let all: Vec3 = near.iter().map(|&k| gradient(k)).sum();
-                owners.into_iter().map(move |o| {
-                    let g = near
-                        .iter()
-                        .filter(|&&k| owner_of(k) == o)
-                        .map(|&k| gradient(k))
-                        .sum();
-                    (j as u32, o, g, all)
-                })
+                owners
+                    .into_iter()
+                    .map(|o| {
+                        let g = near
+                            .iter()
+                            .filter(|&&k| owner_of(k) == o)
+                            .map(|&k| gradient(k))
+                            .sum();
+                        (j as u32, o, g, all)
+                    })
+                    .collect()
             })
             .collect();
         self.particle.clear();

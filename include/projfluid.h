@@ -879,7 +879,9 @@ enum PfStatus pf_pose_identity(struct PfPose *out);
  * Adds a box-shaped rigid body of `kind` (a `PfBodyKind`) with half-extents
  * `half_extents[0..3]` (m, along the body's x, y and z axes) centred on its frame's origin,
  * placed by `*pose`, and stores its id in `*out_id`. Its surface is sampled with boundary
- * particles about r apart (Poisson disk, as `pf_world_add_mesh`), reproducibly.
+ * particles about r apart (Poisson disk, as `pf_world_add_mesh`), reproducibly, and the
+ * samples are set back r into the body (half way through parts thinner than 2r), so that
+ * the fluid meets the box's own surface and a floating box displaces its own volume.
  *
  * `density` (kg/m³) fills the box: it is required (> 0) for `PF_BODY_DYNAMIC` bodies,
  * whose mass and inertia it gives; for static and kinematic bodies 0 means none, and a
@@ -1087,8 +1089,9 @@ enum PfStatus pf_body_get_centre_of_mass(const struct PfWorld *world,
 /**
  * Copies the fluid's force on body `id` during the last step into `force[0..3]` (N) and its
  * torque about the body's centre of mass into `torque[0..3]` (N·m); both are 0 before the
- * first step. The loads are provisional: their distribution and scale are approximations
- * (docs/method.md §11.3), accurate in sign but not yet in magnitude.
+ * first step. The load is the momentum the boundary particles of the body took from the
+ * fluid in that step, followed through the solver's iteration (docs/method.md §11.3); an
+ * engine's rigid solver can apply it for two-way coupling (see c_examples/coupling.c).
  *
  * Errors: `PF_ERROR_NULL_POINTER` (either array NULL: neither is written),
  * `PF_ERROR_INVALID_ARGUMENT` (an unknown id, named). Thread safety: one thread at a time
@@ -1106,7 +1109,7 @@ enum PfStatus pf_body_get_force_torque(const struct PfWorld *world,
  * Copies the fluid's force on the container walls, static obstacles and boundary particles
  * together during the last step into `force[0..3]` (N); static bodies report theirs
  * separately (`pf_body_get_force_torque`). It is measured only in worlds with bodies, and
- * is 0 otherwise and before the first step. Provisional, as the bodies' loads.
+ * is 0 otherwise and before the first step. Measured as the bodies' loads are.
  *
  * Errors: `PF_ERROR_NULL_POINTER`. Thread safety: one thread at a time per world.
  *
@@ -1115,6 +1118,32 @@ enum PfStatus pf_body_get_force_torque(const struct PfWorld *world,
  */
 enum PfStatus pf_world_get_wall_force(const struct PfWorld *world,
                                       double *force);
+
+/**
+ * Creates a world from a scene and stores its handle in `*out`: `name_or_path` (a
+ * NUL-terminated UTF-8 string) is the name of a built-in scene (`dam_break_small`,
+ * `fountain`, …; `projfluid scenes` lists them) or the path of a JSON scene file
+ * (docs/scene-format.md). The world has the scene's parameters (read them with
+ * `pf_world_get_params`; `threads` as the scene sets it, 0 = one per core), containers,
+ * obstacles, rigid bodies (body `i` of the scene gets id `i`), fluid blocks, emitters, sinks
+ * and domain, at time 0, ready to step; the scene's duration and output settings are not
+ * part of a world. The same scene gives the same world as `projfluid run`, bit for bit.
+ * The caller owns the world and frees it with `pf_world_destroy`. On failure `*out` is set to
+ * NULL (when `out` is not NULL).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (name_or_path or out NULL), `PF_ERROR_INVALID_ARGUMENT`:
+ * a string that is not UTF-8; a name that is neither a built-in scene nor an existing file
+ * (the message lists the built-in names); a file that cannot be read, is not valid JSON or
+ * not a valid scene (the message starts with the path and names the key and value, or the
+ * line and column); an obstacle or body mesh that cannot be read or sampled
+ * (`obstacles[i]: …`, `bodies[i]: …`).
+ * Thread safety: may be called from any thread; each call makes its own world.
+ *
+ * # Safety
+ * `name_or_path` must be NULL or a NUL-terminated string; `out` must be NULL or point to a writable `PfWorld*`.
+ */
+enum PfStatus pf_world_create_from_scene(const char *name_or_path,
+                                         struct PfWorld **out);
 
 #ifdef __cplusplus
 }  // extern "C"

@@ -4,6 +4,7 @@ reads; rigid bodies are in :mod:`projfluid.bodies`, emitters and sinks in
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable
 from ctypes import byref, c_char, c_double, c_float, c_size_t, c_uint32, c_uint64, c_void_p
@@ -84,7 +85,10 @@ class World(BodiesMixin, FlowMixin):
 
     def __del__(self) -> None:
         world = getattr(self, "_world", None)
-        if world is not None:
+        if world is None:
+            return
+        # At interpreter exit the library or the threading module may be gone already.
+        with contextlib.suppress(Exception):
             world.close()
 
     def __repr__(self) -> str:

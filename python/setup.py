@@ -5,8 +5,9 @@ Environment:
   CARGO                    the cargo to run (default: cargo on PATH)
   CARGO_TARGET_DIR         cargo's target directory (default: target/ of the checkout);
                            set it to the one `cargo test` uses to reuse its build
-  PROJFLUID_CARGO_PROFILE  the cargo profile (default: release); `test` reuses the library
-                           `cargo test` built, as CI does
+  PROJFLUID_CARGO_PROFILE  the cargo profile (default: release)
+  PROJFLUID_LIBRARY        an already built libprojfluid.so to bundle instead of running
+                           cargo (CI bundles the one `cargo test` built and tested)
 """
 
 from __future__ import annotations
@@ -66,13 +67,25 @@ def build_library() -> Path:
     return built
 
 
+def library() -> Path:
+    """The library to bundle: `$PROJFLUID_LIBRARY`, or the one cargo builds."""
+    prebuilt = os.environ.get("PROJFLUID_LIBRARY")
+    if not prebuilt:
+        return build_library()
+    path = Path(prebuilt).resolve()
+    if not path.is_file():
+        raise RuntimeError(f"PROJFLUID_LIBRARY={prebuilt} is not a file")
+    print(f"bundling the C library {path}", flush=True)
+    return path
+
+
 class BuildWithCargo(build_py):
     """`build_py` that also builds the C library and copies it, stripped, into the package."""
 
     def run(self) -> None:
         super().run()
-        built = build_library()
-        destination = Path(self.build_lib) / "projfluid" / built.name
+        built = library()
+        destination = Path(self.build_lib) / "projfluid" / library_file_name()
         destination.parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(built, destination)
         strip = shutil.which("strip")

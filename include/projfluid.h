@@ -1134,6 +1134,32 @@ enum PfStatus pf_body_get_force_torque(const struct PfWorld *world,
 enum PfStatus pf_world_get_wall_force(const struct PfWorld *world,
                                       double *force);
 
+/**
+ * Creates a world from a scene and stores its handle in `*out`: `name_or_path` (a
+ * NUL-terminated UTF-8 string) is the name of a built-in scene (`dam_break_small`,
+ * `fountain`, …; `projfluid scenes` lists them) or the path of a JSON scene file
+ * (docs/scene-format.md). The world has the scene's parameters (read them with
+ * `pf_world_get_params`; `threads` as the scene sets it, 0 = one per core), containers,
+ * obstacles, rigid bodies (body `i` of the scene gets id `i`), fluid blocks, emitters, sinks
+ * and domain, at time 0, ready to step; the scene's duration and output settings are not
+ * part of a world. The same scene gives the same world as `projfluid run`, bit for bit.
+ * The caller owns the world and frees it with `pf_world_destroy`. On failure `*out` is set to
+ * NULL (when `out` is not NULL).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (name_or_path or out NULL), `PF_ERROR_INVALID_ARGUMENT`:
+ * a string that is not UTF-8; a name that is neither a built-in scene nor an existing file
+ * (the message lists the built-in names); a file that cannot be read, is not valid JSON or
+ * not a valid scene (the message starts with the path and names the key and value, or the
+ * line and column); an obstacle or body mesh that cannot be read or sampled
+ * (`obstacles[i]: …`, `bodies[i]: …`).
+ * Thread safety: may be called from any thread; each call makes its own world.
+ *
+ * # Safety
+ * `name_or_path` must be NULL or a NUL-terminated string; `out` must be NULL or point to a writable `PfWorld*`.
+ */
+enum PfStatus pf_world_create_from_scene(const char *name_or_path,
+                                         struct PfWorld **out);
+
 #ifdef __cplusplus
 }  // extern "C"
 #endif  // __cplusplus

@@ -142,6 +142,22 @@ impl Scene {
     pub fn build_world(&self) -> Result<World, Error> {
         self.validate()?;
         let mut world = World::new(self.params.clone())?;
+        self.add_to(&mut world)?;
+        Ok(world)
+    }
+
+    /// Adds the scene's containers, obstacles, bodies, fluid, emitters, sinks and domain to
+    /// `world`, an empty world created with the scene's parameters on a thread pool of the
+    /// caller's (as the C API's `pf_world_create_from_scene` does); [`Scene::build_world`]
+    /// creates one itself. The scene is validated first. On an error the world may hold
+    /// part of the scene: discard it.
+    pub fn fill_world(&self, world: &mut World) -> Result<(), Error> {
+        self.validate()?;
+        self.add_to(world)
+    }
+
+    /// [`Scene::fill_world`] without the validation.
+    fn add_to(&self, world: &mut World) -> Result<(), Error> {
         for (i, c) in self.containers.iter().enumerate() {
             let aabb = Aabb {
                 min: Vec3::from(c.min),
@@ -158,14 +174,14 @@ impl Scene {
                 .add_boundary_mesh(&mesh)
                 .map_err(|e| prefixed(e, &prefix))?;
         }
-        self.add_bodies(&mut world)?;
+        self.add_bodies(world)?;
         for (i, b) in self.fluid_blocks.iter().enumerate() {
             world
                 .add_fluid_block(Vec3::from(b.start), b.count, Vec3::from(b.velocity))
                 .map_err(|e| prefixed(e, &format!("fluid_blocks[{i}]: ")))?;
         }
-        self.add_flow(&mut world)?;
-        Ok(world)
+        self.add_flow(world)?;
+        Ok(())
     }
 
     /// The scene as pretty JSON with every key written out; [`Scene::from_json`] reads it back

@@ -23,13 +23,17 @@ mod status;
 mod version;
 mod world;
 
-// Declared after `world` so that cbindgen lists the body functions after the world's.
+// Declared after `world` so that cbindgen lists the body functions after the world's, and
+// worlds made from scenes last.
 mod body;
+
+mod scene;
 
 pub use body::*;
 pub use mesh::*;
 pub use params::{PfOmega2Rule, PfParams, PfProjectionWeight, PfSolver};
 pub use params::{pf_params_default, pf_params_validate};
+pub use scene::pf_world_create_from_scene;
 pub use status::{PfStatus, pf_last_error_message, pf_status_name};
 pub use version::{PF_ABI_VERSION, pf_abi_version, pf_version_string};
 pub use world::*;

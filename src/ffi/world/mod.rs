@@ -36,7 +36,7 @@ pub struct PfWorld {
 
 impl PfWorld {
     /// A world on a thread pool of `params.threads` workers whose threads can be joined.
-    fn new(params: Params) -> Result<Self, Failure> {
+    pub(in crate::ffi) fn new(params: Params) -> Result<Self, Failure> {
         let handles = Arc::new(Mutex::new(Vec::new()));
         let spawned = Arc::clone(&handles);
         let pool = rayon::ThreadPoolBuilder::new()
@@ -93,7 +93,7 @@ impl PfWorld {
 
     /// Drops the world, which tells its pool to stop, then waits for every worker to exit,
     /// so that no library code runs after `pf_world_destroy` returns.
-    fn shutdown(self) {
+    pub(in crate::ffi) fn shutdown(self) {
         let Self { world, threads } = self;
         drop(world);
         for handle in threads {

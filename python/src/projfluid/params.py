@@ -1,0 +1,212 @@
+"""Simulation parameters: :class:`Params`, a keyword-argument mirror of ``PfParams`` whose
+defaults come from the C library (``pf_params_default``) and whose validation is the C
+library's (``pf_params_validate``)."""
+
+from __future__ import annotations
+
+import dataclasses
+import enum
+import operator
+from ctypes import byref
+from typing import Any
+
+from ._capi import PfParams, lib
+from .errors import check
+
+
+class Solver(enum.IntEnum):
+    """``PfSolver``: the global solver run in each outer iteration."""
+
+    CHEBYSHEV = 0
+    """One Jacobi sweep plus Chebyshev extrapolation over the outer iterations (default)."""
+    JACOBI1 = 1
+    """Exactly one Jacobi sweep per outer iteration."""
+    JACOBI = 2
+    """Jacobi sweeps until the residual drops by 1e-10 or 100 sweeps."""
+    CG = 3
+    """Conjugate gradients until the residual drops by 1e-10 or 100 iterations."""
+    CG1 = 4
+    """One conjugate-gradient (steepest-descent) iteration per outer iteration."""
+    LDLT = 5
+    """Sparse LDLT factorisation once per step, one direct solve per outer iteration."""
+
+
+class Omega2Rule(enum.IntEnum):
+    """``PfOmega2Rule``: how the first Chebyshev weight ω₂ is chosen."""
+
+    CHEBYSHEV = 0
+    """ω₂ = 2/(2 − ρ²) (Wang 2015)."""
+    PAPER = 1
+    """ω₂ = 4/(4 − ρ²), as Sommer et al. (2020) state it (default)."""
+
+
+class ProjectionWeight(enum.IntEnum):
+    """``PfProjectionWeight``: the weight of a particle's share of a local projection."""
+
+    NEIGHBOR_COUNT = 0
+    """w = fluid neighbour count + 1 (default)."""
+    UNIT = 1
+    """w = 1."""
+    UNIFORM = 2
+    """w = the stencil size at rest density for every particle (experimental)."""
+
+
+EnumLike = int | str
+
+_C_DEFAULTS = PfParams()
+check(lib.pf_params_default(byref(_C_DEFAULTS)))
+
+_UNSIGNED = ("chebyshev_delay", "min_outer_iterations", "max_outer_iterations", "threads")
+_ENUMS: dict[str, type[enum.IntEnum]] = {
+    "solver": Solver,
+    "omega2_rule": Omega2Rule,
+    "projection_weight": ProjectionWeight,
+}
+
+
+def _to_enum(kind: type[enum.IntEnum], value: EnumLike, name: str) -> enum.IntEnum:
+    """``value`` as a member of ``kind``: a member, its value, or its name in any case."""
+    if isinstance(value, str):
+        try:
+            return kind[value.upper()]
+        except KeyError:
+            names = ", ".join(m.name.lower() for m in kind)
+            raise ValueError(f"{name} must be one of {names}, got {value!r}") from None
+    try:
+        return kind(value)
+    except ValueError:
+        raise ValueError(f"{name} must be a {kind.__name__}, got {value!r}") from None
+
+
+@dataclasses.dataclass(kw_only=True)
+class Params:
+    """Every setting of a world, in SI units (m, s, kg), with the C library's defaults.
+
+    ``Params(particle_radius=0.02, solver="cg")`` takes keyword arguments only and checks
+    them with the C library: a bad value raises
+    :class:`~projfluid.errors.InvalidArgumentError` carrying the C status and message, which
+    names the field (e.g. ``pf_params_validate: chebyshev_rho must be in [0, 1), got 1.5``).
+    A value C cannot represent at all (a negative thread count, an unknown solver name)
+    raises :class:`ValueError`. Note that, as in C, ``displacement_tolerance`` defaults to
+    3e-3 times the *default* particle radius: scale it yourself with another radius.
+    """
+
+    particle_radius: float = _C_DEFAULTS.particle_radius
+    """Particle radius r (m); lattice spacing 2r, support radius 4r."""
+    rest_density: float = _C_DEFAULTS.rest_density
+    """Rest density ρ0 (kg/m³)."""
+    mass_factor: float = _C_DEFAULTS.mass_factor
+    """Particle mass as a fraction of ρ0·(2r)³."""
+    stiffness: float = _C_DEFAULTS.stiffness
+    """Constraint stiffness k (N/m)."""
+    gravity: tuple[float, float, float] = tuple(_C_DEFAULTS.gravity)
+    """Gravitational acceleration (m/s²)."""
+    solver: Solver = Solver(_C_DEFAULTS.solver)
+    """The global solver (a :class:`Solver`, its value or its name, e.g. ``"cg"``)."""
+    omega2_rule: Omega2Rule = Omega2Rule(_C_DEFAULTS.omega2_rule)
+    """Rule for the first Chebyshev weight."""
+    chebyshev_rho: float = _C_DEFAULTS.chebyshev_rho
+    """Spectral radius estimate ρ_c in [0, 1); only the start value with auto ρ."""
+    chebyshev_delay: int = _C_DEFAULTS.chebyshev_delay
+    """Outer iterations (≥ 1) before Chebyshev extrapolation starts."""
+    chebyshev_gamma: float = _C_DEFAULTS.chebyshev_gamma
+    """Under-relaxation γ of the Chebyshev step, in (0, 1]."""
+    chebyshev_auto_rho: bool = bool(_C_DEFAULTS.chebyshev_auto_rho)
+    """Estimate ρ_c online during the run (True) or use ``chebyshev_rho`` throughout."""
+    projection_weight: ProjectionWeight = ProjectionWeight(_C_DEFAULTS.projection_weight)
+    """Weighting of the local projection."""
+    displacement_tolerance: float = _C_DEFAULTS.displacement_tolerance
+    """Outer stopping threshold τ (m): stop when no particle moved more than τ."""
+    min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations
+    """Smallest number of outer iterations per step (≥ 1)."""
+    max_outer_iterations: int = _C_DEFAULTS.max_outer_iterations
+    """Largest number of outer iterations per step."""
+    cfl_factor: float = _C_DEFAULTS.cfl_factor
+    """CFL factor λ in Δt = λ·0.4·2r/v_max."""
+    dt_min: float = _C_DEFAULTS.dt_min
+    """Smallest CFL step (s)."""
+    dt_max: float = _C_DEFAULTS.dt_max
+    """Largest CFL step (s)."""
+    dt_initial: float = _C_DEFAULTS.dt_initial
+    """CFL step size of the first step (s)."""
+    viscosity: float = _C_DEFAULTS.viscosity
+    """XSPH viscosity coefficient in [0, 1] (0 = off)."""
+    threads: int = _C_DEFAULTS.threads
+    """Worker threads of the world's own pool (0 = one per core)."""
+
+    def __post_init__(self) -> None:
+        for field in dataclasses.fields(self):
+            setattr(self, field.name, _normalized(field.name, getattr(self, field.name)))
+        self.validate()
+
+    def validate(self) -> None:
+        """Checks every field with ``pf_params_validate``; raises
+        :class:`~projfluid.errors.InvalidArgumentError` naming the first bad one."""
+        check(lib.pf_params_validate(byref(self.to_c())))
+
+    def calm(self) -> Params:
+        """A copy with the calm settings (``pf_params_calm``: uniform weighting, Chebyshev
+        at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4·r) under which a settled tank stays at
+        rest; every other field is kept."""
+        c = self.to_c()
+        check(lib.pf_params_calm(byref(c)))
+        return Params.from_c(c)
+
+    def to_c(self) -> PfParams:
+        """The ``PfParams`` struct for these settings. Raises :class:`ValueError` for a
+        value the struct cannot hold (wrong type, negative count, unknown enum name)."""
+        c = PfParams()
+        for field in dataclasses.fields(self):
+            value = _normalized(field.name, getattr(self, field.name))
+            setattr(c, field.name, int(value) if field.name in _INTEGERS else value)
+        return c
+
+    @classmethod
+    def from_c(cls, c: PfParams) -> Params:
+        """The settings held in a ``PfParams`` struct (validated)."""
+        return cls(**{field.name: getattr(c, field.name) for field in dataclasses.fields(cls)})
+
+
+_INTEGERS = (*_ENUMS, *_UNSIGNED, "chebyshev_auto_rho")
+
+
+def _normalized(name: str, value: Any) -> Any:
+    """The field ``name``'s ``value`` in its canonical type, or a :class:`ValueError` naming
+    the field when ``PfParams`` cannot hold it."""
+    if name in _ENUMS:
+        return _to_enum(_ENUMS[name], value, name)
+    if name == "gravity":
+        return _vector3(value, name)
+    if name == "chebyshev_auto_rho":
+        return bool(value)
+    if name in _UNSIGNED:
+        return _unsigned32(value, name)
+    return _real(value, name)
+
+
+def _real(value: Any, name: str) -> float:
+    """``value`` as a float, or a :class:`ValueError` naming ``name``."""
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number, got {value!r}") from None
+
+
+def _unsigned32(value: Any, name: str) -> int:
+    """``value`` as an integer that fits a ``uint32_t``, or a :class:`ValueError`."""
+    try:
+        integer = operator.index(value)
+    except TypeError:
+        raise ValueError(f"{name} must be an integer, got {value!r}") from None
+    if not 0 <= integer <= 0xFFFF_FFFF:
+        raise ValueError(f"{name} must be an integer in 0..4294967295, got {integer}")
+    return integer
+
+
+def _vector3(value: Any, name: str) -> tuple[float, float, float]:
+    """``value`` as three floats, or a :class:`ValueError` naming ``name``."""
+    try:
+        x, y, z = (float(v) for v in value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be three numbers, got {value!r}") from None
+    return (x, y, z)

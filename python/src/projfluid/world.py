@@ -1,0 +1,293 @@
+"""The :class:`World`: a simulation behind a C ``PfWorld`` handle, which it fills, steps and
+reads; rigid bodies are in :mod:`projfluid.bodies`, emitters and sinks in
+:mod:`projfluid.flow`."""
+
+from __future__ import annotations
+
+import contextlib
+import os
+from collections.abc import Callable
+from ctypes import byref, c_char, c_double, c_float, c_size_t, c_uint32, c_uint64, c_void_p
+from types import TracebackType
+from typing import Any
+
+import numpy as np
+
+from . import _arrays
+from ._arrays import Vector3
+from ._capi import PfParams, PfStepStats, lib
+from ._handle import WorldHandle
+from .bodies import BodiesMixin
+from .errors import check
+from .flow import FlowMixin
+from .geometry import Transform
+from .params import Params
+from .stats import StepStats
+
+
+class World(BodiesMixin, FlowMixin):
+    """A simulation: fluid particles, walls and bodies, stepped by the C library.
+
+    Use it as a context manager, which closes it (frees the C world and joins its worker
+    threads) on leaving the block; :meth:`close` does the same and may be called again::
+
+        with projfluid.World(projfluid.Params(threads=2)) as world:
+            world.add_container_box((0, 0, 0), (0.5, 0.5, 0.5))
+            world.add_fluid_box((0.05, 0.05, 0.05), (6, 6, 6))
+            world.advance(0.1)
+            xyz = world.positions()      # (216, 3) float32, metres
+
+    Every method calls the C API; a rejected call raises a
+    :class:`~projfluid.errors.ProjfluidError` subclass carrying the C status and message, and
+    changes nothing. Vectors are in SI units (m, m/s). The GIL is released during every C
+    call, so worlds in different Python threads step in parallel; one world must be used by
+    one thread at a time (another thread's call raises
+    :class:`~projfluid.errors.BusyError`).
+    """
+
+    def __init__(self, params: Params | None = None) -> None:
+        """Creates an empty world with ``params`` (the defaults when None)."""
+        c_params = (params if params is not None else Params()).to_c()
+        handle = c_void_p()
+        check(lib.pf_world_create(byref(c_params), byref(handle)))
+        self._world = WorldHandle(handle)
+
+    @classmethod
+    def _adopt(cls, handle: c_void_p) -> World:
+        """A world owning ``handle``, a live world from the C API."""
+        world = cls.__new__(cls)
+        world._world = WorldHandle(handle)
+        return world
+
+    # --- lifetime ---------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Frees the C world, waiting for its worker threads (and for calls other threads
+        are making on it) to finish. Safe to call more than once; afterwards every other
+        method raises :class:`~projfluid.errors.WorldClosedError`."""
+        self._world.close()
+
+    @property
+    def closed(self) -> bool:
+        """Whether :meth:`close` was called."""
+        return self._world.closed
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(
+        self,
+        kind: type[BaseException] | None,
+        value: BaseException | None,
+        traceback: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    def __del__(self) -> None:
+        world = getattr(self, "_world", None)
+        if world is None:
+            return
+        # At interpreter exit the library or the threading module may be gone already.
+        with contextlib.suppress(Exception):
+            world.close()
+
+    def __repr__(self) -> str:
+        if self.closed:
+            return "<projfluid.World (closed)>"
+        return f"<projfluid.World: {self.fluid_count} fluid particles, t = {self.time:.6g} s>"
+
+    def _call(self, function: Callable[..., int], *args: Any) -> None:
+        """Calls the C ``function`` with the handle and ``args``; raises on failure."""
+        with self._world.use() as handle:
+            check(function(handle, *args))
+
+    # --- filling ----------------------------------------------------------------------
+
+    def add_fluid_box(
+        self,
+        start: Vector3,
+        count: tuple[int, int, int],
+        velocity: Vector3 | None = None,
+    ) -> None:
+        """Adds a block of ``count`` = (nx, ny, nz) fluid particles on a lattice of spacing
+        2r whose first particle is at ``start`` (m), all moving at ``velocity`` (m/s; None:
+        at rest). Particles are numbered x fastest, then y, then z."""
+        try:
+            nx, ny, nz = (int(n) for n in count)
+        except (TypeError, ValueError):
+            raise ValueError(f"count must be three integers, got {count!r}") from None
+        if min(nx, ny, nz) < 0:
+            raise ValueError(f"count must not be negative, got {(nx, ny, nz)}")
+        c_velocity = None if velocity is None else _arrays.floats3(velocity, "velocity")
+        self._call(
+            lib.pf_world_add_fluid_box,
+            _arrays.floats3(start, "start"),
+            (c_size_t * 3)(nx, ny, nz),
+            c_velocity,
+        )
+
+    def add_fluid_particles(self, positions: Any, velocities: Any = None) -> None:
+        """Adds fluid particles at ``positions``, an (n, 3) array (m), at rest or moving at
+        ``velocities``, an (n, 3) array (m/s). Values are rounded to float32, as C sees
+        them."""
+        xyz = _arrays.rows(positions, 3, np.float32, "positions")
+        if velocities is None:
+            self._call(lib.pf_world_add_fluid_particles, _arrays.pointer(xyz, c_float), len(xyz))
+            return
+        v = _arrays.rows(velocities, 3, np.float32, "velocities")
+        if v.shape != xyz.shape:
+            raise ValueError(f"velocities has shape {v.shape}, positions {xyz.shape}")
+        self._call(
+            lib.pf_world_add_fluid_particles_with_velocities,
+            _arrays.pointer(xyz, c_float),
+            _arrays.pointer(v, c_float),
+            len(xyz),
+        )
+
+    def add_boundary_particles(self, positions: Any) -> None:
+        """Adds static boundary particles at ``positions``, an (n, 3) array (m), for
+        surfaces sampled by other means (spacing about r)."""
+        xyz = _arrays.rows(positions, 3, np.float32, "positions")
+        self._call(lib.pf_world_add_boundary_particles, _arrays.pointer(xyz, c_float), len(xyz))
+
+    def add_container_box(self, min: Vector3, max: Vector3, layers: int = 1) -> None:
+        """Adds a closed box from corner ``min`` to corner ``max`` (m) whose walls are
+        ``layers`` (1–3) layers of boundary particles growing outward."""
+        if layers < 0:
+            raise ValueError(f"layers must not be negative, got {layers}")
+        self._call(
+            lib.pf_world_add_container_box,
+            _arrays.floats3(min, "min"),
+            _arrays.floats3(max, "max"),
+            int(layers),
+        )
+
+    def add_mesh(self, vertices: Any, triangles: Any, transform: Transform | None = None) -> None:
+        """Adds a static obstacle: the triangle mesh with ``vertices``, an (n, 3) array (m),
+        and ``triangles``, an (m, 3) integer array of zero-based vertex indices, placed by
+        ``transform`` (None: as given). Its surface is sampled with boundary particles about
+        r apart; the mesh itself is not kept."""
+        v = _arrays.rows(vertices, 3, np.float32, "vertices")
+        t = _arrays.indices(triangles, "triangles")
+        args = (_arrays.pointer(v, c_float), len(v), _arrays.pointer(t, c_uint32), len(t))
+        if transform is None:
+            self._call(lib.pf_world_add_mesh, *args)
+        else:
+            self._call(lib.pf_world_add_mesh_transformed, *args, byref(transform.to_c()))
+
+    def add_obj(self, path: str | os.PathLike[str], transform: Transform | None = None) -> None:
+        """Adds a static obstacle read from the Wavefront OBJ file at ``path`` (coordinates in
+        metres), placed by ``transform`` and sampled as :meth:`add_mesh`."""
+        c_transform = None if transform is None else byref(transform.to_c())
+        self._call(lib.pf_world_add_obj, os.fsencode(path), c_transform)
+
+    # --- stepping ---------------------------------------------------------------------
+
+    def step(self, dt: float = 0.0) -> StepStats:
+        """Takes one step: of the CFL-limited size when ``dt`` is 0, else of ``dt`` seconds
+        (at most 1). Returns what it did."""
+        return self._stepped(lib.pf_world_step, float(dt))
+
+    def advance(self, seconds: float) -> StepStats:
+        """Takes CFL-limited steps until ``seconds`` (s) have passed, shortening the last one
+        to land exactly. Returns what the last step did."""
+        return self._stepped(lib.pf_world_advance, float(seconds))
+
+    def relax(self, seconds: float, damping: float) -> StepStats:
+        """Steps like :meth:`advance` for ``seconds``, scaling every fluid velocity by
+        exp(−damping·Δt) after each step (``damping`` in 1/s), to settle a tank."""
+        return self._stepped(lib.pf_world_relax, float(seconds), float(damping))
+
+    def _stepped(self, function: Callable[..., int], *args: Any) -> StepStats:
+        """Calls the stepping ``function``, then reads the statistics, holding the handle
+        for both (so that a :meth:`close` from another thread comes after them)."""
+        stats = PfStepStats()
+        with self._world.use() as handle:
+            check(function(handle, *args))
+            check(lib.pf_world_last_step_stats(handle, byref(stats)))
+        return StepStats.from_c(stats)
+
+    # --- reading ----------------------------------------------------------------------
+
+    def _size(self, function: Callable[..., int]) -> int:
+        out = c_size_t()
+        self._call(function, byref(out))
+        return out.value
+
+    @property
+    def fluid_count(self) -> int:
+        """Number of fluid particles."""
+        return self._size(lib.pf_world_fluid_count)
+
+    @property
+    def boundary_count(self) -> int:
+        """Number of boundary particles (walls, obstacles and bodies)."""
+        return self._size(lib.pf_world_boundary_count)
+
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+        out = c_double()
+        self._call(lib.pf_world_time, byref(out))
+        return out.value
+
+    @property
+    def params(self) -> Params:
+        """The world's parameters (a copy; a world's parameters cannot change)."""
+        out = PfParams()
+        self._call(lib.pf_world_get_params, byref(out))
+        return Params.from_c(out)
+
+    @property
+    def last_step(self) -> StepStats:
+        """What the last step did, and the step count and time."""
+        out = PfStepStats()
+        self._call(lib.pf_world_last_step_stats, byref(out))
+        return StepStats.from_c(out)
+
+    def _read(
+        self,
+        function: Callable[..., int],
+        out: np.ndarray | None,
+        columns: int,
+        dtype: Any,
+        ctype: Any,
+        name: str,
+    ) -> np.ndarray:
+        """Fills ``out`` (or a new array) of shape (n, columns) or (n,) with ``function``."""
+        with self._world.use() as handle:
+            n = c_size_t()
+            check(lib.pf_world_fluid_count(handle, byref(n)))
+            shape = (n.value, columns) if columns > 1 else (n.value,)
+            array = _arrays.output(out, shape, dtype, name)
+            check(function(handle, _arrays.pointer(array, ctype), array.size, None))
+        return array
+
+    def positions(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The fluid particles' positions (m) as an (n, 3) float32 array, in ascending id
+        order. Given ``out`` (C-contiguous, that shape and dtype), C writes into it and it is
+        returned: no copy, no allocation."""
+        return self._read(lib.pf_world_get_positions, out, 3, np.float32, c_float, "out")
+
+    def velocities(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The fluid particles' velocities (m/s) as an (n, 3) float32 array; ``out`` as in
+        :meth:`positions`."""
+        return self._read(lib.pf_world_get_velocities, out, 3, np.float32, c_float, "out")
+
+    def densities(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The fluid particles' densities (kg/m³) as an (n,) float32 array, as the last step
+        left them; ``out`` as in :meth:`positions`."""
+        return self._read(lib.pf_world_get_densities, out, 1, np.float32, c_float, "out")
+
+    def ids(self, out: np.ndarray | None = None) -> np.ndarray:
+        """The fluid particles' ids as an (n,) uint64 array, ascending: the order of every
+        other read. Ids count from 0 in the order particles were added and are never
+        reused. ``out`` as in :meth:`positions`."""
+        return self._read(lib.pf_world_get_ids, out, 1, np.uint64, c_uint64, "out")
+
+    def positions_hash(self) -> str:
+        """SHA-256 (64 hex digits) of the positions' exact double-precision bits, in id
+        order: equal strings mean bitwise equal simulations (C, Rust or Python)."""
+        out = (c_char * 65)()
+        self._call(lib.pf_world_positions_hash, out, len(out), None)
+        return out.value.decode()

@@ -1,0 +1,144 @@
+"""The World's lifetime, its reads (shapes, dtypes, no copies), parameters and statistics."""
+
+from __future__ import annotations
+
+import gc
+import math
+
+import numpy as np
+import pytest
+
+import projfluid
+from conftest import small_params
+
+N = 6 * 7 * 5
+
+
+def test_a_world_closes_once_and_closing_again_is_safe() -> None:
+    world = projfluid.World(small_params())
+    assert not world.closed
+    world.close()
+    world.close()
+    assert world.closed
+    assert repr(world) == "<projfluid.World (closed)>"
+    with projfluid.World(small_params()) as inside:
+        assert not inside.closed
+    assert inside.closed
+    inside.close()
+    # A world dropped without closing is closed by the garbage collector.
+    projfluid.World(small_params())
+    gc.collect()
+
+
+def test_the_context_manager_closes_on_an_exception() -> None:
+    with pytest.raises(RuntimeError), projfluid.World(small_params()) as world:
+        raise RuntimeError("boom")
+    assert world.closed
+
+
+def test_reads_are_numpy_arrays_of_the_documented_shapes_and_dtypes(
+    world: projfluid.World,
+) -> None:
+    world.advance(0.02)
+    positions, velocities = world.positions(), world.velocities()
+    densities, ids = world.densities(), world.ids()
+    assert positions.shape == (N, 3) and positions.dtype == np.float32
+    assert velocities.shape == (N, 3) and velocities.dtype == np.float32
+    assert densities.shape == (N,) and densities.dtype == np.float32
+    assert ids.shape == (N,) and ids.dtype == np.uint64
+    assert all(a.flags.c_contiguous for a in (positions, velocities, densities, ids))
+    assert np.array_equal(ids, np.arange(N))
+    assert np.isfinite(positions).all() and (positions[:, 1] > 0).all()
+    assert (velocities[:, 1] < 0).any()  # falling
+    assert 900 < float(np.median(densities)) < 1100  # kg/m³, about water's
+    # The first particle of a box is at its start: x fastest, then y, then z.
+    with projfluid.World(small_params()) as fresh:
+        fresh.add_fluid_box((0.03, 0.03, 0.03), (6, 7, 5))
+        xyz = fresh.positions()
+        assert xyz[0] == pytest.approx((0.03, 0.03, 0.03))
+        assert xyz[1] == pytest.approx((0.07, 0.03, 0.03))  # spacing 2r = 0.04 m
+        assert xyz[6] == pytest.approx((0.03, 0.07, 0.03))
+
+
+def test_reads_fill_a_callers_array_in_place(world: projfluid.World) -> None:
+    world.step()
+    out = np.zeros((N, 3), dtype=np.float32)
+    assert world.positions(out=out) is out
+    assert np.array_equal(out, world.positions())
+    dens = np.zeros(N, dtype=np.float32)
+    assert world.densities(out=dens) is dens
+    ids = np.zeros(N, dtype=np.uint64)
+    assert world.ids(out=ids) is ids
+    for bad in (
+        np.zeros((N, 3), dtype=np.float64),
+        np.zeros((N + 1, 3), dtype=np.float32),
+        np.zeros((3, N), dtype=np.float32).T,
+    ):
+        with pytest.raises(ValueError):
+            world.positions(out=bad)
+    frozen = np.zeros((N, 3), dtype=np.float32)
+    frozen.flags.writeable = False
+    with pytest.raises(ValueError, match="writeable"):
+        world.velocities(out=frozen)
+
+
+def test_inputs_accept_any_array_like_and_are_rounded_to_float32() -> None:
+    with projfluid.World(small_params()) as world:
+        world.add_container_box([0, 0, 0], np.array([0.5, 0.4, 0.3]))
+        world.add_fluid_particles(np.array([[0.1, 0.1, 0.1], [0.2, 0.1, 0.1]]))
+        world.add_fluid_particles([(0.3, 0.1, 0.1)], velocities=[(1.0, 0.0, 0.0)])
+        assert world.fluid_count == 3
+        assert world.positions()[2, 0] == np.float32(0.3)
+        assert world.velocities()[2, 0] == 1.0
+
+
+def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World) -> None:
+    defaults = projfluid.Params()
+    assert defaults.particle_radius == 0.025
+    assert defaults.solver == projfluid.Solver.CHEBYSHEV
+    assert defaults.gravity == (0.0, -9.81, 0.0)
+    assert defaults.chebyshev_auto_rho is True
+    p = projfluid.Params(solver="cg", projection_weight=1, threads=np.int64(3))
+    assert p.solver is projfluid.Solver.CG
+    assert p.projection_weight is projfluid.ProjectionWeight.UNIT
+    assert p.threads == 3 and type(p.threads) is int
+    assert projfluid.Params.from_c(p.to_c()) == p
+    assert world.params == small_params()
+    calm = defaults.calm()
+    assert calm.projection_weight == projfluid.ProjectionWeight.UNIFORM
+    assert calm.chebyshev_rho == 0.99 and calm.chebyshev_auto_rho is False
+    assert calm.particle_radius == defaults.particle_radius
+
+
+def test_steps_report_their_statistics(world: projfluid.World) -> None:
+    assert world.last_step.step_count == 0
+    first = world.step(0.002)
+    assert first.step_count == 1 and first.dt == 0.002 and first.time == 0.002
+    assert first.outer_iterations >= 1
+    stats = world.advance(0.05)
+    assert math.isclose(stats.time, 0.052) and world.time == stats.time
+    assert stats.escaped_count == 0 and stats.nan_count == 0
+    assert 0.0 <= stats.density_error_avg_percent <= stats.density_error_max_percent
+    assert world.last_step == stats
+    relaxed = world.relax(0.01, 4.0)
+    assert relaxed.step_count > stats.step_count
+
+
+def test_obstacles_add_boundary_particles(world: projfluid.World) -> None:
+    walls = world.boundary_count
+    cube = np.array([[x, y, z] for z in (0.2, 0.28) for y in (0.1, 0.18) for x in (0.3, 0.38)])
+    faces = [[0, 1, 3], [0, 3, 2], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
+             [2, 3, 7], [2, 7, 6], [0, 2, 6], [0, 6, 4], [1, 3, 7], [1, 7, 5]]  # fmt: skip
+    world.add_mesh(cube, faces)
+    with_cube = world.boundary_count
+    assert with_cube > walls
+    world.add_mesh(
+        cube, np.array(faces, dtype=np.int64), projfluid.Transform(translate=(0, 0.1, 0))
+    )
+    assert world.boundary_count == 2 * with_cube - walls
+    world.add_boundary_particles([[0.25, 0.01, 0.15]])
+    assert world.boundary_count == 2 * with_cube - walls + 1
+
+
+def test_the_version_is_the_c_librarys() -> None:
+    assert projfluid.__version__ == "0.1.0"

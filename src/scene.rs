@@ -169,7 +169,8 @@ impl Scene {
         }
         for (i, o) in self.obstacles.iter().enumerate() {
             let prefix = format!("obstacles[{i}]: ");
-            let mesh = o.mesh().map_err(|e| prefixed(e, &prefix))?;
+            let r = self.params.particle_radius;
+            let mesh = o.mesh(r).map_err(|e| prefixed(e, &prefix))?;
             world
                 .add_boundary_mesh(&mesh)
                 .map_err(|e| prefixed(e, &prefix))?;

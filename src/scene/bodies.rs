@@ -96,7 +96,7 @@ impl SceneBody {
             .mesh(r),
             &BodyShape::Sphere { radius } => Shape::Sphere { radius }.mesh(r),
             &BodyShape::Cylinder { radius, height } => Shape::Cylinder { radius, height }.mesh(r),
-            BodyShape::Mesh(source) => source.mesh(),
+            BodyShape::Mesh(source) => source.mesh(r),
         }
     }
 
@@ -145,9 +145,9 @@ fn named(prefix: &str, e: Error) -> Error {
     }
 }
 
-/// Checks body `i`'s values (not its mesh file, read when the world is built).
-pub(super) fn check_body(i: usize, b: &SceneBody) -> Result<(), Error> {
-    let key = format!("bodies[{i}]");
+/// Checks the sizes of the shape at JSON key `key` (a body or an obstacle): positive and
+/// finite lengths (m), or a valid mesh source.
+pub(super) fn check_shape(key: &str, shape: &BodyShape) -> Result<(), Error> {
     let positive = |name: &str, v: f64| {
         if v.is_finite() && v > 0.0 {
             Ok(())
@@ -159,21 +159,28 @@ pub(super) fn check_body(i: usize, b: &SceneBody) -> Result<(), Error> {
             ))
         }
     };
-    match &b.shape {
+    match shape {
         BodyShape::Box { half_extents } => {
             for (a, &v) in half_extents.iter().enumerate() {
                 positive(&format!("box.half_extents[{a}]"), v)?;
             }
+            Ok(())
         }
-        &BodyShape::Sphere { radius } => positive("sphere.radius", radius)?,
+        &BodyShape::Sphere { radius } => positive("sphere.radius", radius),
         &BodyShape::Cylinder { radius, height } => {
             positive("cylinder.radius", radius)?;
-            positive("cylinder.height", height)?;
+            positive("cylinder.height", height)
         }
         BodyShape::Mesh(source) => {
-            super::validate::check_mesh_source(&format!("{key}.mesh"), source)?
+            super::validate::check_mesh_source(&format!("{key}.mesh"), source)
         }
     }
+}
+
+/// Checks body `i`'s values (not its mesh file, read when the world is built).
+pub(super) fn check_body(i: usize, b: &SceneBody) -> Result<(), Error> {
+    let key = format!("bodies[{i}]");
+    check_shape(&key, &b.shape)?;
     match b.density {
         None if b.kind == BodyKind::Dynamic => {
             return Err(Error::invalid(

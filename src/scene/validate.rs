@@ -2,6 +2,7 @@
 
 use super::{ContainerSpec, FluidBlock, ObstacleSpec, Scene};
 use crate::Error;
+use crate::body::Shape;
 
 /// The most fluid particles a world accepts (see `World::add_fluid_particles`).
 const MAX_PARTICLES: usize = u32::MAX as usize / 64;
@@ -67,8 +68,18 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
 }
 
 /// An obstacle-style mesh source (the obstacle or body mesh at JSON key `key`): a known
-/// generated mesh, and a valid transform.
+/// generated mesh or a primitive with positive sizes, and a valid transform.
 pub(super) fn check_mesh_source(key: &str, o: &ObstacleSpec) -> Result<(), Error> {
+    if let &super::MeshSource::Primitive(shape) = &o.mesh {
+        let sized = match shape {
+            Shape::Box { half_extents } => super::BodyShape::Box {
+                half_extents: half_extents.into(),
+            },
+            Shape::Sphere { radius } => super::BodyShape::Sphere { radius },
+            Shape::Cylinder { radius, height } => super::BodyShape::Cylinder { radius, height },
+        };
+        super::bodies::check_shape(key, &sized)?;
+    }
     if let super::MeshSource::Generated(name) = &o.mesh
         && !super::obstacle::NAMES.contains(&name.as_str())
     {

@@ -21,23 +21,23 @@ enum KindFile {
 /// `box`.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct BoxFile {
-    half_extents: [f64; 3],
+pub(super) struct BoxFile {
+    pub(super) half_extents: [f64; 3],
 }
 
 /// `sphere`.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct SphereFile {
-    radius: f64,
+pub(super) struct SphereFile {
+    pub(super) radius: f64,
 }
 
 /// `cylinder`.
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct CylinderFile {
-    radius: f64,
-    height: f64,
+pub(super) struct CylinderFile {
+    pub(super) radius: f64,
+    pub(super) height: f64,
 }
 
 /// One entry of `bodies`.

@@ -1,9 +1,11 @@
-//! One entry of a scene file's `obstacles`: a mesh source (`obj` or `generated`) and its
-//! placement, converted to and from [`ObstacleSpec`].
+//! One entry of a scene file's `obstacles`: a mesh source (`obj`, `generated`, or a `box`,
+//! `sphere` or `cylinder`) and its placement, converted to and from [`ObstacleSpec`].
 
-use crate::Error;
+use super::bodies::{BoxFile, CylinderFile, SphereFile};
+use crate::body::Shape;
 use crate::boundary::Transform;
 use crate::scene::{MeshSource, ObstacleSpec};
+use crate::{Error, Vec3};
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -15,6 +17,12 @@ pub(super) struct ObstacleFile {
     obj: Option<String>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     generated: Option<String>,
+    #[serde(rename = "box", default, skip_serializing_if = "Option::is_none")]
+    cuboid: Option<BoxFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    sphere: Option<SphereFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    cylinder: Option<CylinderFile>,
     scale: Option<Scale>,
     rotate_deg: Option<[f64; 3]>,
     translate: Option<[f64; 3]>,
@@ -32,21 +40,40 @@ impl ObstacleFile {
     /// The obstacle, with a relative `obj` path taken relative to `base` (the scene file's
     /// directory, if any). `key` names the entry in errors (e.g. `obstacles[2]`).
     pub(super) fn into_spec(self, key: &str, base: Option<&Path>) -> Result<ObstacleSpec, Error> {
-        let mesh = match (self.obj, self.generated) {
-            (Some(obj), None) => {
-                let path = PathBuf::from(obj);
-                MeshSource::Obj(match base {
-                    Some(dir) if path.is_relative() => dir.join(path),
-                    _ => path,
-                })
-            }
-            (None, Some(name)) => MeshSource::Generated(name),
+        let mut sources = Vec::new();
+        if let Some(obj) = self.obj {
+            let path = PathBuf::from(obj);
+            sources.push(MeshSource::Obj(match base {
+                Some(dir) if path.is_relative() => dir.join(path),
+                _ => path,
+            }));
+        }
+        if let Some(name) = self.generated {
+            sources.push(MeshSource::Generated(name));
+        }
+        if let Some(b) = self.cuboid {
+            sources.push(MeshSource::Primitive(Shape::Box {
+                half_extents: Vec3::from(b.half_extents),
+            }));
+        }
+        if let Some(b) = self.sphere {
+            sources.push(MeshSource::Primitive(Shape::Sphere { radius: b.radius }));
+        }
+        if let Some(c) = self.cylinder {
+            sources.push(MeshSource::Primitive(Shape::Cylinder {
+                radius: c.radius,
+                height: c.height,
+            }));
+        }
+        let mesh = match sources.pop() {
+            Some(mesh) if sources.is_empty() => mesh,
             _ => {
                 return Err(Error::InvalidArgument {
                     field: key.to_string(),
                     message: format!(
-                        "{key} needs exactly one mesh: `obj` (an OBJ file path) or \
-                         `generated` (one of {})",
+                        "{key} needs exactly one mesh: `obj` (an OBJ file path), `generated` \
+                         (one of {}), `box` ({{\"half_extents\": [x, y, z]}}), `sphere` \
+                         ({{\"radius\": r}}) or `cylinder` ({{\"radius\": r, \"height\": h}})",
                         crate::scene::obstacle::NAMES.join(", ")
                     ),
                 });
@@ -71,15 +98,29 @@ impl ObstacleFile {
     pub(super) fn from_spec(spec: &ObstacleSpec) -> Self {
         let t = &spec.transform;
         let [x, y, z] = t.scale;
+        let (mut obj, mut generated) = (None, None);
+        let (mut cuboid, mut sphere, mut cylinder) = (None, None, None);
+        match &spec.mesh {
+            MeshSource::Obj(path) => obj = Some(path.to_string_lossy().into_owned()),
+            MeshSource::Generated(name) => generated = Some(name.clone()),
+            &MeshSource::Primitive(Shape::Box { half_extents }) => {
+                cuboid = Some(BoxFile {
+                    half_extents: half_extents.into(),
+                })
+            }
+            &MeshSource::Primitive(Shape::Sphere { radius }) => {
+                sphere = Some(SphereFile { radius })
+            }
+            &MeshSource::Primitive(Shape::Cylinder { radius, height }) => {
+                cylinder = Some(CylinderFile { radius, height })
+            }
+        }
         ObstacleFile {
-            obj: match &spec.mesh {
-                MeshSource::Obj(path) => Some(path.to_string_lossy().into_owned()),
-                MeshSource::Generated(_) => None,
-            },
-            generated: match &spec.mesh {
-                MeshSource::Generated(name) => Some(name.clone()),
-                MeshSource::Obj(_) => None,
-            },
+            obj,
+            generated,
+            cuboid,
+            sphere,
+            cylinder,
             scale: Some(if x == y && y == z {
                 Scale::Uniform(x)
             } else {
@@ -141,7 +182,7 @@ mod tests {
             scene.obstacles[0].mesh,
             MeshSource::Obj(dir.0.join("meshes/cube.obj"))
         );
-        let mesh = scene.obstacles[0].mesh().unwrap();
+        let mesh = scene.obstacles[0].mesh(0.025).unwrap();
         // The cube scaled to 0.2 × 0.1 × 0.2, turned 90° about y (x → −z), moved.
         let bounds = mesh.bounds();
         let expected_min = Vec3::new(0.4, 2.0, 0.4);
@@ -205,5 +246,57 @@ mod tests {
             msg,
             "obstacles[0].scale must be positive along every axis, got [1.0, -1.0, 1.0]"
         );
+    }
+
+    /// Boxes, spheres and cylinders need no OBJ: each is tessellated, placed by the transform
+    /// and sampled like a mesh, reads back from the JSON it writes, and has its sizes checked.
+    #[test]
+    fn primitive_obstacles_are_meshes_placed_like_any_other() {
+        let text = with_obstacle(
+            r#"{"box": {"half_extents": [0.1, 0.2, 0.1]}, "translate": [0.5, 2.5, 0.5]},
+               {"sphere": {"radius": 0.15}, "translate": [0.5, 1.6, 0.5]},
+               {"cylinder": {"radius": 0.1, "height": 0.4}, "rotate_deg": [90, 0, 0], "translate": [0.3, 2.0, 0.7]}"#,
+        );
+        let scene = Scene::from_json(&text).unwrap();
+        let r = scene.params.particle_radius;
+        let bounds: Vec<_> = scene
+            .obstacles
+            .iter()
+            .map(|o| o.mesh(r).unwrap().bounds())
+            .collect();
+        let close = |a: Vec3, b: Vec3| (a - b).norm() < 1e-9;
+        assert!(
+            close(bounds[0].min, Vec3::new(0.4, 2.3, 0.4)),
+            "{:?}",
+            bounds[0]
+        );
+        assert!(
+            close(bounds[0].max, Vec3::new(0.6, 2.7, 0.6)),
+            "{:?}",
+            bounds[0]
+        );
+        // A tessellated sphere lies within its radius and reaches it at the poles.
+        assert!((bounds[1].max.y - 1.75).abs() < 1e-9, "{:?}", bounds[1]);
+        assert!(bounds[1].max.x <= 0.65 + 1e-9 && bounds[1].min.x >= 0.35 - 1e-9);
+        // Turned 90° about x, the cylinder's axis lies along z.
+        assert!(
+            (bounds[2].max.z - bounds[2].min.z - 0.4).abs() < 1e-9,
+            "{:?}",
+            bounds[2]
+        );
+        assert_eq!(Scene::from_json(&scene.to_json()).unwrap(), scene);
+        let with = scene.build_world().unwrap();
+        let mut without = scene.clone();
+        without.obstacles.clear();
+        assert!(with.boundary_count() > without.build_world().unwrap().boundary_count() + 100);
+
+        let msg = message(Scene::from_json(&with_obstacle(
+            r#"{"sphere": {"radius": -0.1}}"#,
+        )));
+        assert_names(&msg, &["obstacles[0].sphere.radius", "-0.1", "positive"]);
+        let msg = message(Scene::from_json(&with_obstacle(
+            r#"{"box": {"half_extents": [0.1, 0, 0.1]}, "sphere": {"radius": 0.1}}"#,
+        )));
+        assert_names(&msg, &["obstacles[0] needs exactly one mesh", "cylinder"]);
     }
 }

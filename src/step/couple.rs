@@ -62,10 +62,12 @@ pub(crate) struct Coupling {
     gradient: Vec<Vec3>,
     /// The same over all boundary particles near j (1/m).
     all: Vec<Vec3>,
-    /// Δt²k n_j / Â_jj: how much of the share the global step keeps.
+    /// Δt²k n_j / Â_jj (dimensionless): how much of the share the global step keeps.
     keep: Vec<f64>,
-    /// Δt²k w_j / Â_jj (kg⁰): how much of λ_j·gradient it adds (1/m² · m³ = m).
+    /// Δt²k w_j / Â_jj (dimensionless): the factor of the boundary's correction λ_j·g that
+    /// the global step adds to the share.
     gain: Vec<f64>,
+    /// The shares at X^(k−1), X^(k) and X^(k+1) (m).
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,

@@ -2,6 +2,7 @@
 #ifndef PROJFLUID_TEST_CHECK_H
 #define PROJFLUID_TEST_CHECK_H
 
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -43,5 +44,30 @@
         if (msg_ == NULL || strncmp(msg_, "pf_", 3) != 0 || strlen(msg_) < 12)           \
             FAIL("%s gave no helpful message", #call);                                   \
     } while (0)
+
+/* What a rejected call must leave as it was: counts, time, steps and the positions' digest. */
+typedef struct {
+    size_t fluid, boundary;
+    double time;
+    uint64_t steps;
+    char hash[65];
+} WorldSnapshot;
+
+static inline WorldSnapshot world_snapshot(const PfWorld *w) {
+    WorldSnapshot s;
+    PfStepStats st;
+    OK(pf_world_fluid_count(w, &s.fluid));
+    OK(pf_world_boundary_count(w, &s.boundary));
+    OK(pf_world_time(w, &s.time));
+    OK(pf_world_last_step_stats(w, &st));
+    s.steps = st.step_count;
+    OK(pf_world_positions_hash(w, s.hash, sizeof s.hash, NULL));
+    return s;
+}
+
+static inline int same_world(const WorldSnapshot *a, const WorldSnapshot *b) {
+    return a->fluid == b->fluid && a->boundary == b->boundary && a->time == b->time &&
+           a->steps == b->steps && strcmp(a->hash, b->hash) == 0;
+}
 
 #endif

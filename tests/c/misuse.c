@@ -8,30 +8,9 @@
 
 #include "check.h"
 
-typedef struct {
-    size_t fluid, boundary;
-    double time;
-    uint64_t steps;
-    char hash[65];
-} Snapshot;
-
-static Snapshot snapshot(const PfWorld *w) {
-    Snapshot s;
-    PfStepStats st;
-    OK(pf_world_fluid_count(w, &s.fluid));
-    OK(pf_world_boundary_count(w, &s.boundary));
-    OK(pf_world_time(w, &s.time));
-    OK(pf_world_last_step_stats(w, &st));
-    s.steps = st.step_count;
-    OK(pf_world_positions_hash(w, s.hash, sizeof s.hash, NULL));
-    return s;
-}
-
-static void same(const PfWorld *w, const Snapshot *before, int line) {
-    Snapshot now = snapshot(w);
-    if (now.fluid != before->fluid || now.boundary != before->boundary ||
-        now.time != before->time || now.steps != before->steps ||
-        strcmp(now.hash, before->hash) != 0) {
+static void same(const PfWorld *w, const WorldSnapshot *before, int line) {
+    WorldSnapshot now = world_snapshot(w);
+    if (!same_world(&now, before)) {
         fprintf(stderr, "misuse.c:%d: a rejected call changed the world\n", line);
         exit(1);
     }
@@ -43,7 +22,7 @@ static char last_msg[512];
 /* A rejected call on world `w`: expected status, a message, and no change. */
 #define REJECT(w, expected, call)                                                         \
     do {                                                                                  \
-        Snapshot before_ = snapshot(w);                                                   \
+        WorldSnapshot before_ = world_snapshot(w);                                        \
         EXPECT(expected, call);                                                           \
         snprintf(last_msg, sizeof last_msg, "%s", pf_last_error_message());               \
         same(w, &before_, __LINE__);                                                      \

@@ -22,39 +22,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-typedef struct {
-    size_t fluid, boundary;
-    double time;
-    uint64_t steps;
-    char hash[65];
-} Snapshot;
-
-static Snapshot snapshot(const PfWorld *w) {
-    Snapshot s;
-    PfStepStats st;
-    OK(pf_world_fluid_count(w, &s.fluid));
-    OK(pf_world_boundary_count(w, &s.boundary));
-    OK(pf_world_time(w, &s.time));
-    OK(pf_world_last_step_stats(w, &st));
-    s.steps = st.step_count;
-    OK(pf_world_positions_hash(w, s.hash, sizeof s.hash, NULL));
-    return s;
-}
-
-static int same(const Snapshot *a, const Snapshot *b) {
-    return a->fluid == b->fluid && a->boundary == b->boundary && a->time == b->time &&
-           a->steps == b->steps && strcmp(a->hash, b->hash) == 0;
-}
-
 /* The call must return PF_ERROR_OUT_OF_MEMORY, say so, and change nothing. */
 #define OUT_OF_MEMORY(w, call)                                                           \
     do {                                                                                 \
-        Snapshot before_ = snapshot(w);                                                  \
+        WorldSnapshot before_ = world_snapshot(w);                                       \
         EXPECT(PF_ERROR_OUT_OF_MEMORY, call);                                            \
         if (strstr(pf_last_error_message(), "out of memory") == NULL)                    \
             FAIL("%s: the message does not say out of memory", #call);                   \
-        Snapshot after_ = snapshot(w);                                                   \
-        if (!same(&before_, &after_)) FAIL("%s changed the world", #call);               \
+        WorldSnapshot after_ = world_snapshot(w);                                        \
+        if (!same_world(&before_, &after_)) FAIL("%s changed the world", #call);         \
     } while (0)
 
 /* Bytes of address space the process uses now. */
@@ -114,10 +90,10 @@ static int child(void) {
 
     /* With the limit lifted the same world steps on, from where it was. */
     limit_address_space(-1.0);
-    Snapshot before = snapshot(w);
+    WorldSnapshot before = world_snapshot(w);
     OK(pf_world_step(w, 0.0));
     OK(pf_world_advance(w, 0.01));
-    Snapshot after = snapshot(w);
+    WorldSnapshot after = world_snapshot(w);
     CHECK(after.fluid == before.fluid && after.steps > before.steps + 1);
     CHECK(after.time > before.time + 0.01 - 1e-12);
     PfStepStats st;

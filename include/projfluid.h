@@ -222,7 +222,7 @@ typedef struct PfParams {
     enum PfOmega2Rule omega2_rule;
     /**
      * Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.85.
+     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.98.
      */
     double chebyshev_rho;
     /**
@@ -235,13 +235,19 @@ typedef struct PfParams {
     double chebyshev_gamma;
     /**
      * 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
-     * value); 0: use `chebyshev_rho` throughout (set it to 0 to fix ρ_c). Default 1.
+     * value); 0: use `chebyshev_rho` throughout. Default 0.
      */
     uint32_t chebyshev_auto_rho;
     /**
      * Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
      */
     enum PfProjectionWeight projection_weight;
+    /**
+     * Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
+     * 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
+     * most η. Default 2.5e-4.
+     */
+    double density_tolerance;
     /**
      * Outer stopping threshold τ (m): stop when no particle moved more than τ in one
      * outer iteration. Default 3e-3·r.
@@ -256,7 +262,7 @@ typedef struct PfParams {
      */
     uint32_t max_outer_iterations;
     /**
-     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.5.
+     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.
      */
     double cfl_factor;
     /**
@@ -438,7 +444,8 @@ enum PfStatus pf_params_default(struct PfParams *out);
 
 /**
  * Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
- * at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4 times its particle radius), under which a
+ * at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0) and τ = 3e-4 times its
+ * particle radius), under which a
  * settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
  * field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
  * does not validate, leaving it unchanged.

@@ -174,15 +174,16 @@ pub struct ChebyshevParams {
     /// Estimate ρ_c online instead of using `rho` (docs/solvers.md, "Choosing ρ"): every step of five
     /// or more outer iterations estimates the plain iteration's contraction μ from how fast
     /// its own extrapolated iterates contracted, and ρ_c = 0.97·μ (smoothed, clamped to
-    /// [0.5, 0.925]); `rho` is only the value used until the first estimate. On by default
-    /// (it met its goal on every built-in scene); setting a fixed ρ (scene `"rho": 0.9`,
-    /// `--rho 0.9`) turns it off.
+    /// [0.5, 0.925]); `rho` is only the value used until the first estimate. Off by default:
+    /// the estimate follows the iteration's late, asymptotic contraction, while the density
+    /// rule ends most steps within a few iterations, where a larger fixed ρ pays
+    /// (docs/method.md §5.3).
     pub auto_rho: bool,
 }
 
-/// Chosen by measurement on `dam_break_30k` (docs/method.md §4); also the
-/// starting value of the online estimate.
-pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.85;
+/// Chosen by measurement on `dam_break_30k` with the density rule (docs/method.md §4,
+/// docs/performance.md); also the starting value of the online estimate.
+pub const DEFAULT_CHEBYSHEV_RHO: f64 = 0.98;
 /// Chosen by measurement on `dam_break_30k` (docs/method.md §4).
 pub const DEFAULT_CHEBYSHEV_DELAY: usize = 1;
 
@@ -193,7 +194,7 @@ impl Default for ChebyshevParams {
             delay: DEFAULT_CHEBYSHEV_DELAY,
             omega2_rule: Omega2Rule::Paper,
             gamma: 1.0,
-            auto_rho: true,
+            auto_rho: false,
         }
     }
 }
@@ -215,6 +216,9 @@ pub struct Params {
     pub solver: SolverKind,
     /// Chebyshev settings (used by [`SolverKind::Chebyshev`]).
     pub chebyshev: ChebyshevParams,
+    /// Outer stopping threshold η on the average density error (dimensionless, 0 = off):
+    /// stop when Σ_i max(ρ_i/ρ0 − 1, 0)/N at the iterate is at most η (docs/method.md §4).
+    pub density_tolerance: f64,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in an iteration.
     pub displacement_tolerance: f64,
     /// Smallest number of outer iterations per step (≥ 1).
@@ -257,6 +261,14 @@ pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
     }
 }
 
+/// Default η: an average density error of 0.025 %, chosen by measurement on `dam_break_30k`
+/// (docs/performance.md, "Accuracy per cost").
+pub const DEFAULT_DENSITY_TOLERANCE: f64 = 2.5e-4;
+
+/// Default CFL factor λ, chosen by measurement on `dam_break_30k` (docs/performance.md,
+/// "Accuracy per cost"): at 1 a particle moves at most 0.8r per step.
+pub const DEFAULT_CFL_FACTOR: f64 = 1.0;
+
 /// Default particle radius (m).
 pub const DEFAULT_PARTICLE_RADIUS: f64 = 0.025;
 /// Default τ as a multiple of the particle radius: chosen by measurement on `dam_break_30k`
@@ -284,11 +296,12 @@ impl Params {
             gravity: [0.0, -9.81, 0.0],
             solver: SolverKind::Chebyshev,
             chebyshev: ChebyshevParams::default(),
+            density_tolerance: DEFAULT_DENSITY_TOLERANCE,
             displacement_tolerance: DEFAULT_TOLERANCE_PER_RADIUS * r,
             min_outer_iterations: 1,
             max_outer_iterations: 100,
             projection_weight: ProjectionWeight::NeighborCount,
-            cfl_factor: 0.5,
+            cfl_factor: DEFAULT_CFL_FACTOR,
             dt_min: 1e-4,
             dt_max: 5e-3,
             dt_initial: 1e-3,
@@ -306,6 +319,7 @@ impl Params {
     pub fn calm(self) -> Self {
         Self {
             projection_weight: ProjectionWeight::Uniform,
+            density_tolerance: 0.0,
             displacement_tolerance: CALM_TOLERANCE_PER_RADIUS * self.particle_radius,
             chebyshev: ChebyshevParams {
                 rho: 0.99,
@@ -367,8 +381,10 @@ mod tests {
             ),
             (0.99, 0.5, false)
         );
+        assert_eq!(calm.density_tolerance, 0.0);
         let restored = Params {
             projection_weight: base.projection_weight,
+            density_tolerance: base.density_tolerance,
             displacement_tolerance: base.displacement_tolerance,
             chebyshev: base.chebyshev,
             ..calm.clone()

@@ -137,6 +137,13 @@ fn the_walls_carry_the_weight_of_the_water_and_the_push_of_the_held_box() {
 fn paddle_push(weight: ProjectionWeight) -> (f64, f64, f64) {
     let p = Params {
         gravity: [0.0; 3],
+        // The uniform weighting runs with the displacement rule alone, as in the calm
+        // settings (docs/method.md §4).
+        density_tolerance: if weight == ProjectionWeight::Uniform {
+            0.0
+        } else {
+            Params::default().density_tolerance
+        },
         ..params(weight)
     };
     let mut world = World::new(p).unwrap();

@@ -17,6 +17,8 @@ pub struct RunSummary {
     pub rho: f64,
     /// ρ_c was estimated online (`--rho auto`).
     pub rho_auto: bool,
+    /// Outer stopping threshold η on the average density error (a fraction; 0 = off).
+    pub eta: f64,
     /// Outer stopping threshold τ (m).
     pub tau: f64,
     /// Worker threads.
@@ -153,6 +155,7 @@ impl RunAccumulator {
                 p.chebyshev.rho
             },
             rho_auto: p.chebyshev.auto_rho,
+            eta: p.density_tolerance,
             tau: p.displacement_tolerance,
             threads: world.thread_count(),
             particles: world.fluid_count(),

@@ -278,7 +278,10 @@ fn rho_auto_runs_and_reports_its_estimate() {
         "auto",
         "--threads",
         "1",
-        // A tight τ makes the steps long enough to measure the contraction.
+        // The displacement rule alone with a tight τ makes the steps long enough to measure
+        // the contraction.
+        "--eta",
+        "0",
         "--tau",
         "2.5e-6",
         "--stats",
@@ -292,10 +295,9 @@ fn rho_auto_runs_and_reports_its_estimate() {
     // The options reach the world that runs.
     assert_eq!(json["threads"], 1);
     let rho = json["rho"].as_f64().unwrap();
-    assert!(
-        (0.5..=0.925).contains(&rho) && rho != 0.85,
-        "mean rho {rho}"
-    );
+    // The mean over the steps: the starting value 0.98 until the first estimate, then
+    // estimates within [0.5, 0.925].
+    assert!((0.5..0.98).contains(&rho), "mean rho {rho}");
 }
 
 /// Asserts that `path` holds a PNG image.
@@ -342,6 +344,9 @@ fn bench_writes_one_consistent_row_per_scene_and_solver() {
         "15",
         "--threads",
         "1",
+        // The displacement rule alone: every solver then converges to the same τ.
+        "--eta",
+        "0",
         "--out",
         out_dir.to_str().unwrap(),
     ]);

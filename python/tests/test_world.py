@@ -97,7 +97,8 @@ def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World)
     assert defaults.particle_radius == 0.025
     assert defaults.solver == projfluid.Solver.CHEBYSHEV
     assert defaults.gravity == (0.0, -9.81, 0.0)
-    assert defaults.chebyshev_auto_rho is True
+    assert defaults.chebyshev_auto_rho is False and defaults.chebyshev_rho == 0.98
+    assert defaults.density_tolerance == 2.5e-4 and defaults.cfl_factor == 1.0
     p = projfluid.Params(solver="cg", projection_weight=1, threads=np.int64(3))
     assert p.solver is projfluid.Solver.CG
     assert p.projection_weight is projfluid.ProjectionWeight.UNIT
@@ -107,6 +108,7 @@ def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World)
     calm = defaults.calm()
     assert calm.projection_weight == projfluid.ProjectionWeight.UNIFORM
     assert calm.chebyshev_rho == 0.99 and calm.chebyshev_auto_rho is False
+    assert calm.density_tolerance == 0.0
     assert calm.particle_radius == defaults.particle_radius
 
 

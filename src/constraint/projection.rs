@@ -23,6 +23,9 @@ pub struct Projection {
     pub materialized: bool,
     /// Start of this constraint's segment in [`Corrections`] (meaningful when `materialized`).
     pub segment: u32,
+    /// ρ_i at the iterate, before any correction (kg/m³): the density the constraint was
+    /// evaluated at, which the density stopping rule reads (docs/method.md §4).
+    pub density: f64,
 }
 
 impl DensityConstraint {
@@ -190,6 +193,9 @@ impl DensityConstraint {
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
                 (_, false) => self.first_step_density(out, scratch),
             };
+            if step == 0 {
+                out.density = rho;
+            }
             let c = (rho / self.rest_density - 1.0).max(0.0);
             if step > 0 && !materialized && (c > CONSTRAINT_GOAL || self.materialize_all) {
                 // A second step is needed (or requested): write the first step's corrections out.

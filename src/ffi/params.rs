@@ -75,17 +75,21 @@ pub struct PfParams {
     /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_PAPER`.
     pub omega2_rule: PfOmega2Rule,
     /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.85.
+    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.98.
     pub chebyshev_rho: f64,
     /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
     pub chebyshev_delay: u32,
     /// Under-relaxation γ of the Chebyshev step, in (0, 1]. Default 1.
     pub chebyshev_gamma: f64,
     /// 1: estimate ρ_c online during the run (`chebyshev_rho` is then only the starting
-    /// value); 0: use `chebyshev_rho` throughout (set it to 0 to fix ρ_c). Default 1.
+    /// value); 0: use `chebyshev_rho` throughout. Default 0.
     pub chebyshev_auto_rho: u32,
     /// Weighting of the local projection. Default `PF_WEIGHT_NEIGHBOR_COUNT`.
     pub projection_weight: PfProjectionWeight,
+    /// Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
+    /// 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
+    /// most η. Default 2.5e-4.
+    pub density_tolerance: f64,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
     /// outer iteration. Default 3e-3·r.
     pub displacement_tolerance: f64,
@@ -93,7 +97,7 @@ pub struct PfParams {
     pub min_outer_iterations: u32,
     /// Largest number of outer iterations per step (≤ 100000). Default 100.
     pub max_outer_iterations: u32,
-    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.5.
+    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.
     pub cfl_factor: f64,
     /// Smallest CFL step (s). Default 1e-4.
     pub dt_min: f64,
@@ -138,6 +142,7 @@ impl From<&Params> for PfParams {
                 ProjectionWeight::Unit => PfProjectionWeight::PF_WEIGHT_UNIT,
                 ProjectionWeight::Uniform => PfProjectionWeight::PF_WEIGHT_UNIFORM,
             },
+            density_tolerance: p.density_tolerance,
             displacement_tolerance: p.displacement_tolerance,
             min_outer_iterations: small(p.min_outer_iterations),
             max_outer_iterations: small(p.max_outer_iterations),
@@ -225,6 +230,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
             gamma: field!(chebyshev_gamma),
             auto_rho,
         },
+        density_tolerance: field!(density_tolerance),
         displacement_tolerance: field!(displacement_tolerance),
         min_outer_iterations: count(field!(min_outer_iterations)),
         max_outer_iterations: count(field!(max_outer_iterations)),
@@ -257,7 +263,8 @@ pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
 }
 
 /// Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
-/// at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4 times its particle radius), under which a
+/// at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0) and τ = 3e-4 times its
+/// particle radius), under which a
 /// settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
 /// field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
 /// does not validate, leaving it unchanged.

@@ -63,6 +63,13 @@ impl Params {
                 "must lie in [0, 1]",
             ));
         }
+        if !(self.density_tolerance.is_finite() && (0.0..1.0).contains(&self.density_tolerance)) {
+            return Err(Error::invalid(
+                "density_tolerance",
+                self.density_tolerance,
+                "must lie in [0, 1) (0 turns the density rule off)",
+            ));
+        }
         let c = &self.chebyshev;
         if !(c.rho.is_finite() && (0.0..1.0).contains(&c.rho)) {
             return Err(Error::invalid("rho", c.rho, "must lie in [0, 1)"));

@@ -64,6 +64,7 @@ struct SolverFile {
     delay: Option<usize>,
     omega2: Option<Omega2Rule>,
     gamma: Option<f64>,
+    eta: Option<f64>,
     tau: Option<f64>,
     max_iterations: Option<usize>,
     min_iterations: Option<usize>,
@@ -201,6 +202,7 @@ impl SceneFile {
         c.delay = s.delay.unwrap_or(c.delay);
         c.omega2_rule = s.omega2.unwrap_or(c.omega2_rule);
         set(&mut c.gamma, s.gamma);
+        set(&mut p.density_tolerance, s.eta);
         set(&mut p.displacement_tolerance, s.tau);
         p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
         p.min_outer_iterations = s.min_iterations.unwrap_or(p.min_outer_iterations);
@@ -289,6 +291,7 @@ impl SceneFile {
                 delay: Some(c.delay),
                 omega2: Some(c.omega2_rule),
                 gamma: Some(c.gamma),
+                eta: Some(p.density_tolerance),
                 tau: Some(p.displacement_tolerance),
                 max_iterations: Some(p.max_outer_iterations),
                 min_iterations: Some(p.min_outer_iterations),

@@ -109,6 +109,7 @@ fn to_json_key(error: Error) -> Error {
     let key = match field.as_str() {
         "rho" | "delay" | "gamma" => format!("solver.{field}"),
         "displacement_tolerance" => "solver.tau".to_string(),
+        "density_tolerance" => "solver.eta".to_string(),
         "min_outer_iterations" => "solver.min_iterations".to_string(),
         "max_outer_iterations" => "solver.max_iterations".to_string(),
         "cfl_factor" | "dt_min" | "dt_max" | "dt_initial" => format!("time.{field}"),

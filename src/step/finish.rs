@@ -1,5 +1,5 @@
 //! The end of a step (docs/method.md §1.3): velocities from the positions, the new
-//! positions, densities at them, the non-pressure forces, and the step's statistics.
+//! positions, densities at them (kept from the last local step where it evaluated them), the non-pressure forces, and the step's statistics.
 
 use super::StepBuffers;
 use super::iterate::Outcome;
@@ -7,7 +7,6 @@ use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use crate::forces::NonPressureForce;
-use crate::params::Params;
 use crate::reduce;
 use crate::stats::{StepStats, StepTimings};
 use rayon::prelude::*;
@@ -15,7 +14,6 @@ use std::time::Instant;
 
 /// What the end of a step reads besides the fluid and the buffers.
 pub(super) struct Finish<'a> {
-    pub params: &'a Params,
     pub constraint: &'a DensityConstraint,
     pub boundary: &'a Boundary,
     pub forces: &'a mut [Box<dyn NonPressureForce>],
@@ -33,7 +31,6 @@ pub(super) fn finish(
     timings: &mut StepTimings,
 ) -> StepStats {
     let Finish {
-        params,
         constraint,
         boundary,
         forces,
@@ -55,7 +52,15 @@ pub(super) fn finish(
         boundary_psi: &boundary.psi,
         weights: &b.weights,
     };
-    constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
+    if outcome.densities_known {
+        // The local step that ended the iteration evaluated them at these positions.
+        fluid.densities.clear();
+        fluid
+            .densities
+            .par_extend(b.projections.par_iter().map(|p| p.density));
+    } else {
+        constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
+    }
     for force in forces.iter_mut() {
         force.apply(constraint, &nb, fluid, &mut b.next);
     }
@@ -69,7 +74,7 @@ pub(super) fn finish(
         dt,
         outer_iterations: outcome.outer,
         inner_iterations: outcome.inner,
-        hit_max_iterations: outcome.displacement >= params.displacement_tolerance,
+        hit_max_iterations: !outcome.converged,
         rho: outcome.rho,
         last_displacement: outcome.displacement,
         density_error_avg,

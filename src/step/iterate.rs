@@ -1,11 +1,11 @@
 //! The outer local/global iteration of a step (docs/method.md §1.3, §3, §4): the system
 //! matrix of formulation F1 frozen for the step, then local projections and global solves
-//! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until no particle moved farther
-//! than τ.
+//! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until the fluid's average
+//! compression is at most η or no particle moved farther than τ.
 
 use super::{StepBuffers, couple};
 use crate::boundary::Boundary;
-use crate::constraint::{CHUNK, DensityConstraint, Neighborhood};
+use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection};
 use crate::params::{Params, SolverKind};
 use crate::solver::{Chebyshev, GlobalSolver, Sweep};
 use crate::stats::StepTimings;
@@ -36,10 +36,15 @@ pub(super) struct Outcome {
     pub displacement: f64,
     /// Chebyshev's ρ_c in this step (0 without extrapolation).
     pub rho: f64,
+    /// A stopping rule held (rather than the iteration limit).
+    pub converged: bool,
+    /// The density rule stopped the iteration after a local step, whose densities at
+    /// X^(k) are in `b.projections` (docs/method.md §4).
+    pub densities_known: bool,
 }
 
-/// Iterates until the displacement rule or the iteration limit stops; the result X^(k) is
-/// left in `b.current`. Adds the local and global times to `timings`.
+/// Iterates until the density rule, the displacement rule or the iteration limit stops; the
+/// result X^(k) is left in `b.current`. Adds the local and global times to `timings`.
 pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimings) -> Outcome {
     let Iteration {
         params,
@@ -76,6 +81,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     let accelerate = params.solver == SolverKind::Chebyshev;
     let single_sweep = solver.single_diagonal_sweep();
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
+    let (mut converged, mut densities_known) = (false, false);
     b.displacements.clear();
     if couple {
         let (lists, diagonal) = (&b.fluid_lists, &b.system.diagonal);
@@ -86,6 +92,14 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         let t = Instant::now();
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
         let t_local = t.elapsed().as_secs_f64();
+        if outer >= params.min_outer_iterations
+            && average_compression(constraint, &b.projections) <= params.density_tolerance
+        {
+            // The density rule: X^(k) is the result, and its densities are known.
+            timings.local += t_local;
+            (converged, densities_known) = (true, true);
+            break;
+        }
         let omega = if accelerate {
             chebyshev.next_weight(outer)
         } else {
@@ -157,6 +171,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         timings.local += t_local;
         timings.global += t.elapsed().as_secs_f64() - t_local;
         if outer >= params.min_outer_iterations && displacement < params.displacement_tolerance {
+            converged = true;
             break;
         }
     }
@@ -170,7 +185,16 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         inner,
         displacement,
         rho,
+        converged,
+        densities_known,
     }
+}
+
+/// The fluid's average compression at the iterate of the last local step,
+/// Σ_i max(ρ_i/ρ0 − 1, 0) / N (dimensionless), the same for any thread count.
+fn average_compression(constraint: &DensityConstraint, projections: &[Projection]) -> f64 {
+    let rest = constraint.rest_density;
+    reduce::sum(projections, |p| (p.density / rest - 1.0).max(0.0)) / projections.len() as f64
 }
 
 /// max_i |a_i − b_i| (m).

@@ -151,7 +151,6 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         }
         finish::finish(
             finish::Finish {
-                params,
                 constraint,
                 boundary,
                 forces,

@@ -65,6 +65,7 @@ class PfParams(ctypes.Structure):
         ("chebyshev_gamma", c_double),
         ("chebyshev_auto_rho", c_uint32),
         ("projection_weight", c_int),
+        ("density_tolerance", c_double),
         ("displacement_tolerance", c_double),
         ("min_outer_iterations", c_uint32),
         ("max_outer_iterations", c_uint32),

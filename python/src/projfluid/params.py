@@ -115,6 +115,9 @@ class Params:
     """Estimate ρ_c online during the run (True) or use ``chebyshev_rho`` throughout."""
     projection_weight: ProjectionWeight = ProjectionWeight(_C_DEFAULTS.projection_weight)
     """Weighting of the local projection."""
+    density_tolerance: float = _C_DEFAULTS.density_tolerance
+    """Outer stopping threshold η on the average density error, a fraction in [0, 1): stop
+    when the mean of max(ρ/ρ0 − 1, 0) over the fluid is at most η (0 turns the rule off)."""
     displacement_tolerance: float = _C_DEFAULTS.displacement_tolerance
     """Outer stopping threshold τ (m): stop when no particle moved more than τ."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations

@@ -166,8 +166,8 @@ fn rho_auto_is_read_written_and_checked() {
     assert!(scene.params.chebyshev.auto_rho);
     let again = Scene::from_json(&scene.to_json()).unwrap();
     assert_eq!(again.params, scene.params);
-    // The online estimate is the default, and a number always gives a fixed ρ_c.
-    assert!(Scene::from_json(GOOD).unwrap().params.chebyshev.auto_rho);
+    // A fixed ρ_c is the default, and a number always gives a fixed ρ_c.
+    assert!(!Scene::from_json(GOOD).unwrap().params.chebyshev.auto_rho);
     let fixed = GOOD.replacen(
         "\"fluid_blocks\"",
         "\"solver\": {\"rho\": 0.9}, \"fluid_blocks\"",

@@ -32,7 +32,7 @@ pub(crate) struct RunArgs {
     scene: Option<String>,
     /// Continue the run saved in this checkpoint file, bit for bit, to the end it was going
     /// to (or for --steps/--duration more).
-    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "rho", "tau"])]
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["solver", "rho", "eta", "tau"])]
     resume: Option<PathBuf>,
     /// Write a checkpoint (checkpoint_NNNNNN.pfck, NNNNNN the step count) every N steps.
     #[arg(long, value_name = "N")]

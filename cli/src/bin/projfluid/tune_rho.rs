@@ -60,6 +60,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
     let mut scene = Scene::resolve(&args.scene).map_err(|e| Failure::Input(e.to_string()))?;
     let options = ParamOptions {
         rho: None,
+        eta: None,
         tau: args.tau,
         threads: args.threads,
     };

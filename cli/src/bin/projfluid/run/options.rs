@@ -13,6 +13,10 @@ pub(crate) struct ParamOptions {
     /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
     #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
     pub(crate) rho: Option<RhoArg>,
+    /// Outer stopping threshold η on the average density error, a fraction (2.5e-4 =
+    /// 0.025 %; 0 turns the density rule off).
+    #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
+    pub(crate) eta: Option<f64>,
     /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub(crate) tau: Option<f64>,
@@ -28,6 +32,9 @@ impl ParamOptions {
         if let Some(rho) = self.rho {
             rho.apply(&mut p.chebyshev);
         }
+        if let Some(eta) = self.eta {
+            p.density_tolerance = eta;
+        }
         if let Some(tau) = self.tau {
             p.displacement_tolerance = tau;
         }
@@ -37,9 +44,10 @@ impl ParamOptions {
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 3] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 4] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
+            ("solver.eta", "--eta", self.eta.is_some()),
             ("solver.tau", "--tau", self.tau.is_some()),
             ("threads", "--threads", self.threads.is_some()),
         ]

@@ -7,17 +7,19 @@ use std::io::Write;
 pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
     let rows = [
         ("scene", s.scene.clone()),
-        (
-            "solver",
-            if s.rho_auto {
-                format!(
-                    "{} (rho auto, mean {:.3}; tau {:.3e} m)",
-                    s.solver, s.rho, s.tau
-                )
+        ("solver", {
+            let rho = if s.rho_auto {
+                format!("rho auto, mean {:.3}", s.rho)
             } else {
-                format!("{} (rho {}, tau {:.3e} m)", s.solver, s.rho, s.tau)
-            },
-        ),
+                format!("rho {}", s.rho)
+            };
+            format!(
+                "{} ({rho}; eta {:.3} %, tau {:.3e} m)",
+                s.solver,
+                s.eta * 100.0,
+                s.tau
+            )
+        }),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),
         ("boundary particles", s.boundary_particles.to_string()),

@@ -78,6 +78,41 @@ mod step {
         assert!(shortcut.last_step().unwrap().density_error_max > 0.0);
     }
 
+    /// The density rule alone (τ too small to stop anything) ends every step with the
+    /// fluid's average compression at most η, a tighter η costs more outer iterations for a
+    /// smaller error, and the rule binds: some steps end just under η, not far below it.
+    #[test]
+    fn density_rule_bounds_the_average_compression() {
+        let run = |eta: f64| {
+            let mut world = small_dam_break_with(Params {
+                density_tolerance: eta,
+                displacement_tolerance: 1e-15,
+                ..Params::default()
+            });
+            let (mut outer, mut worst, mut binding) = (0, 0.0f64, 0);
+            for _ in 0..40 {
+                let s = world.step().unwrap();
+                assert!(!s.hit_max_iterations, "η {eta}: {s:?}");
+                assert!(s.density_error_avg <= eta, "η {eta}: {s:?}");
+                outer += s.outer_iterations;
+                worst = worst.max(s.density_error_avg);
+                binding += usize::from(s.density_error_avg > 0.5 * eta);
+            }
+            (outer, worst, binding)
+        };
+        let (loose_outer, loose_worst, loose_binding) = run(5e-4);
+        let (tight_outer, tight_worst, tight_binding) = run(1e-4);
+        assert!(
+            loose_binding > 5 && tight_binding > 5,
+            "{loose_binding}, {tight_binding}"
+        );
+        assert!(tight_worst < loose_worst, "{tight_worst} vs {loose_worst}");
+        assert!(
+            tight_outer as f64 > 1.2 * loose_outer as f64,
+            "{tight_outer} vs {loose_outer} outer iterations"
+        );
+    }
+
     /// Steps the small dam break twice for 25 steps, once as is and once changed by
     /// `variant`, and asserts the two trajectories are bitwise the same.
     fn steps_bitwise_alike(variant: impl FnOnce(&mut World)) {

@@ -47,13 +47,19 @@ macro_rules! avx2_dispatch {
 pub(crate) use avx2_dispatch;
 
 /// Whether the processor supports what the AVX-512 builds are compiled for: the AVX-512
-/// subsets F, VL, DQ and BW, and POPCNT.
+/// subsets F, VL, DQ and BW, and POPCNT; and the environment variable
+/// `PROJFLUID_NO_AVX512` is unset. Setting it makes an AVX-512 processor run the AVX2
+/// builds, as a processor without AVX-512 does (for benchmarks, docs/performance.md).
 #[cfg(target_arch = "x86_64")]
 #[inline]
 pub(crate) fn has_avx512() -> bool {
-    std::arch::is_x86_feature_detected!("avx512f")
-        && std::arch::is_x86_feature_detected!("popcnt")
-        && std::arch::is_x86_feature_detected!("avx512vl")
-        && std::arch::is_x86_feature_detected!("avx512dq")
-        && std::arch::is_x86_feature_detected!("avx512bw")
+    static USE_AVX512: std::sync::OnceLock<bool> = std::sync::OnceLock::new();
+    *USE_AVX512.get_or_init(|| {
+        std::env::var_os("PROJFLUID_NO_AVX512").is_none()
+            && std::arch::is_x86_feature_detected!("avx512f")
+            && std::arch::is_x86_feature_detected!("popcnt")
+            && std::arch::is_x86_feature_detected!("avx512vl")
+            && std::arch::is_x86_feature_detected!("avx512dq")
+            && std::arch::is_x86_feature_detected!("avx512bw")
+    })
 }

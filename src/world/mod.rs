@@ -140,19 +140,29 @@ impl World {
     /// `max` outer iterations per step (min = max forces a fixed count, as ρ estimation
     /// needs). Rejects values that [`Params::validate`] rejects, changing nothing.
     pub fn set_outer_iterations(&mut self, min: usize, max: usize) -> Result<(), Error> {
-        let mut params = self.params.clone();
-        params.min_outer_iterations = min;
-        params.max_outer_iterations = max;
-        params.validate()?;
-        self.params = params;
-        Ok(())
+        self.change_params(|p| {
+            p.min_outer_iterations = min;
+            p.max_outer_iterations = max;
+        })
     }
 
     /// Changes the outer stopping threshold τ (m) between steps. Rejects values that
     /// [`Params::validate`] rejects, changing nothing.
     pub fn set_displacement_tolerance(&mut self, tolerance: f64) -> Result<(), Error> {
+        self.change_params(|p| p.displacement_tolerance = tolerance)
+    }
+
+    /// Changes the outer stopping threshold η on the average density error (dimensionless,
+    /// 0 = off) between steps. Rejects values that [`Params::validate`] rejects, changing
+    /// nothing.
+    pub fn set_density_tolerance(&mut self, tolerance: f64) -> Result<(), Error> {
+        self.change_params(|p| p.density_tolerance = tolerance)
+    }
+
+    /// Applies `change` to a copy of the parameters and keeps it if it validates.
+    fn change_params(&mut self, change: impl FnOnce(&mut Params)) -> Result<(), Error> {
         let mut params = self.params.clone();
-        params.displacement_tolerance = tolerance;
+        change(&mut params);
         params.validate()?;
         self.params = params;
         Ok(())

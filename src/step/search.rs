@@ -63,6 +63,10 @@ pub(super) fn predict(
     });
 }
 
+/// The grid's slack on every side, as a fraction of the extent of what it covers: room for
+/// splashes before a rebuild, at the cost of empty cells (12 bytes each).
+const GRID_SLACK: f64 = 0.1;
+
 /// The neighbour grid, kept across steps, and whether it reached its cell limit.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct SearchGrid {
@@ -103,8 +107,8 @@ impl SearchGrid {
                     }
                 })
             };
-            // A quarter of the extent as slack, so a splash does not rebuild the grid every step.
-            let slack = (bounds.max - bounds.min) * 0.25;
+            // Slack, so that a splash does not rebuild the grid every step.
+            let slack = (bounds.max - bounds.min) * GRID_SLACK;
             let h = params.support_radius();
             let grid =
                 UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h);

@@ -27,7 +27,7 @@
  * Version of the binary interface this header describes; compare it with pf_abi_version()
  * at run time to detect a header/library mismatch.
  */
-#define PF_ABI_VERSION 1
+#define PF_ABI_VERSION 2
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything

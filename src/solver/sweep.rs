@@ -12,25 +12,24 @@ pub struct Sweep<'a> {
     pub diagonal: &'a [f64],
     /// X^(k) (m).
     pub current: &'a [Vec3],
-    /// X^(k−1) (m).
-    pub previous: &'a [Vec3],
     /// The recurrence and its weight ω, when the extrapolation changes the iterate.
     pub chebyshev: Option<(&'a Chebyshev, f64)>,
 }
 
 impl Sweep<'_> {
-    /// Writes X^(k+1)_j for the particles `first..` of the right-hand sides `rhs` (kg·m) into
-    /// `next` (m): the sweep X_j + (b_j − Â_jj·X_j)/Â_jj, bitwise as [`super::Jacobi`]
-    /// computes it, then extrapolated. Returns max_j |X^(k+1)_j − X^(k)_j| (m) over the chunk.
-    pub fn apply(&self, first: usize, rhs: &[Vec3], next: &mut [Vec3]) -> f64 {
+    /// For the particles `first..` of the right-hand sides `rhs` (kg·m), replaces X^(k−1)_j
+    /// in `previous` by X^(k+1)_j (m): the sweep X_j + (b_j − Â_jj·X_j)/Â_jj, bitwise as
+    /// [`super::Jacobi`] computes it, then extrapolated, which reads X^(k−1)_j alone, so the
+    /// three iterates need two buffers. Returns max_j |X^(k+1)_j − X^(k)_j| (m) over the chunk.
+    pub fn apply(&self, first: usize, rhs: &[Vec3], previous: &mut [Vec3]) -> f64 {
         let mut largest = f64::NEG_INFINITY;
-        for (j, (b, next)) in (first..).zip(rhs.iter().zip(next)) {
+        for (j, (b, slot)) in (first..).zip(rhs.iter().zip(previous)) {
             let (x, d) = (self.current[j], self.diagonal[j]);
             let mut plain = x + (b - x * d) / d;
             if let Some((chebyshev, omega)) = self.chebyshev {
-                plain = chebyshev.extrapolated(omega, plain, x, self.previous[j]);
+                plain = chebyshev.extrapolated(omega, plain, x, *slot);
             }
-            *next = plain;
+            *slot = plain;
             largest = reduce::nan_max(largest, (plain - x).norm());
         }
         largest

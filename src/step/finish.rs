@@ -62,7 +62,8 @@ pub(super) fn finish(
         constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
     }
     for force in forces.iter_mut() {
-        force.apply(constraint, &nb, fluid, &mut b.next);
+        // X^(k−1) of the finished iteration serves as the forces' scratch.
+        force.apply(constraint, &nb, fluid, &mut b.previous);
     }
     let rest = constraint.rest_density;
     let errors = |rho: &f64| (rho / rest - 1.0).max(0.0);

@@ -68,7 +68,6 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     solver.prepare(&b.system);
 
     b.previous.clone_from(&b.current);
-    b.next.resize(b.current.len(), Vec3::zeros());
     constraint.weights(&b.fluid_lists, &mut b.weights);
     let nb = Neighborhood {
         fluid: &b.fluid_lists,
@@ -133,24 +132,25 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
             let sweep = Sweep {
                 diagonal: &b.system.diagonal,
                 current,
-                previous: &b.previous,
                 chebyshev: extrapolation,
             };
-            // The right-hand side lives only as long as its chunk's sweep.
+            // The right-hand side lives only as long as its chunk's sweep, and X^(k+1)
+            // replaces X^(k−1) in place.
             displacement = b
-                .next
+                .previous
                 .par_chunks_mut(CHUNK)
                 .enumerate()
-                .map(|(chunk, next)| {
+                .map(|(chunk, previous)| {
                     let mut rhs = [Vec3::zeros(); CHUNK];
-                    let rhs = &mut rhs[..next.len()];
+                    let rhs = &mut rhs[..previous.len()];
                     fill_rhs(chunk, rhs);
-                    sweep.apply(chunk * CHUNK, rhs, next)
+                    sweep.apply(chunk * CHUNK, rhs, previous)
                 })
                 .reduce(|| f64::NEG_INFINITY, reduce::nan_max);
             inner += 1;
         } else {
             b.rhs.resize(b.current.len(), Vec3::zeros());
+            b.next.resize(b.current.len(), Vec3::zeros());
             b.rhs
                 .par_chunks_mut(CHUNK)
                 .enumerate()
@@ -164,9 +164,11 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         }
         b.displacements.push(displacement);
 
-        // Rotate: X^(k−1) ← X^(k) ← X^(k+1).
+        // Rotate: X^(k−1) ← X^(k) ← X^(k+1) (which the fused sweep left in `previous`).
         std::mem::swap(&mut b.previous, &mut b.current);
-        std::mem::swap(&mut b.current, &mut b.next);
+        if !single_sweep {
+            std::mem::swap(&mut b.current, &mut b.next);
+        }
         outer += 1;
         timings.local += t_local;
         timings.global += t.elapsed().as_secs_f64() - t_local;

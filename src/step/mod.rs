@@ -29,8 +29,9 @@ use std::time::Instant;
 #[derive(Clone, Debug, Default)]
 pub(crate) struct StepBuffers {
     /// X^(k−1), X^(k), X^(k+1) of the outer iteration (m). `current` receives the prediction
-    /// s at the start of a step; `next` also serves the reordering and the non-pressure
-    /// forces as scratch.
+    /// s at the start of a step; `previous` also serves the reordering and the non-pressure
+    /// forces as scratch. The fused sweep of single-sweep solvers writes X^(k+1) over X^(k−1),
+    /// so `next` is used (and filled) only by the other solvers.
     previous: Vec<Vec3>,
     current: Vec<Vec3>,
     next: Vec<Vec3>,

@@ -168,9 +168,10 @@ pub(super) fn reorder_and_search(
     h: f64,
     b: &mut StepBuffers,
 ) {
-    permute(&b.order, &mut fluid.positions, &mut b.next);
-    permute(&b.order, &mut fluid.velocities, &mut b.next);
-    permute(&b.order, &mut b.current, &mut b.next);
+    // X^(k−1) is free until the iteration starts: it serves as the scratch.
+    permute(&b.order, &mut fluid.positions, &mut b.previous);
+    permute(&b.order, &mut fluid.velocities, &mut b.previous);
+    permute(&b.order, &mut b.current, &mut b.previous);
     permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
     grid.search(
         &b.table,

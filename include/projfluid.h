@@ -262,7 +262,7 @@ typedef struct PfParams {
      */
     uint32_t max_outer_iterations;
     /**
-     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.
+     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.75.
      */
     double cfl_factor;
     /**

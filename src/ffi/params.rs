@@ -97,7 +97,7 @@ pub struct PfParams {
     pub min_outer_iterations: u32,
     /// Largest number of outer iterations per step (≤ 100000). Default 100.
     pub max_outer_iterations: u32,
-    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.
+    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.75.
     pub cfl_factor: f64,
     /// Smallest CFL step (s). Default 1e-4.
     pub dt_min: f64,

@@ -13,6 +13,12 @@ use crate::{Vec3, reduce};
 use rayon::prelude::*;
 use std::time::Instant;
 
+/// The density rule also waits until the last outer iteration moved no particle farther
+/// than this multiple of τ: a few particles still moving fast (a splash particle being pushed
+/// back out of a wall) keep the iteration going, though they hardly change the average
+/// (docs/method.md §4).
+const DENSITY_RULE_MOTION: f64 = 10.0;
+
 /// What the iteration reads besides the buffers.
 pub(super) struct Iteration<'a> {
     pub params: &'a Params,
@@ -92,6 +98,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
         let t_local = t.elapsed().as_secs_f64();
         if outer >= params.min_outer_iterations
+            && displacement < DENSITY_RULE_MOTION * params.displacement_tolerance
             && average_compression(constraint, &b.projections) <= params.density_tolerance
         {
             // The density rule: X^(k) is the result, and its densities are known.

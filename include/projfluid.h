@@ -222,7 +222,7 @@ typedef struct PfParams {
     enum PfOmega2Rule omega2_rule;
     /**
      * Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.98.
+     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.95.
      */
     double chebyshev_rho;
     /**
@@ -245,7 +245,8 @@ typedef struct PfParams {
     /**
      * Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
      * 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
-     * most η. Default 2.5e-4.
+     * most η and the last outer iteration moved no particle farther than
+     * 10·`displacement_tolerance`. Default 2.5e-4.
      */
     double density_tolerance;
     /**

@@ -3,7 +3,7 @@
 
 use projfluid::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
 use projfluid::boundary::Aabb;
-use projfluid::params::ProjectionWeight;
+use projfluid::params::{ChebyshevParams, ProjectionWeight};
 use projfluid::scene::Scene;
 use projfluid::{Params, Vec3, World};
 
@@ -137,14 +137,23 @@ fn the_walls_carry_the_weight_of_the_water_and_the_push_of_the_held_box() {
 fn paddle_push(weight: ProjectionWeight) -> (f64, f64, f64) {
     let p = Params {
         gravity: [0.0; 3],
-        // The uniform weighting runs with the displacement rule alone, as in the calm
-        // settings (docs/method.md §4).
-        density_tolerance: if weight == ProjectionWeight::Uniform {
-            0.0
-        } else {
-            Params::default().density_tolerance
-        },
         ..params(weight)
+    };
+    // The experimental uniform weighting runs with the displacement rule alone and the online
+    // ρ_c at λ = 0.5, the settings it is stable with (docs/solvers.md).
+    let p = if weight == ProjectionWeight::Uniform {
+        Params {
+            density_tolerance: 0.0,
+            cfl_factor: 0.5,
+            chebyshev: ChebyshevParams {
+                rho: 0.85,
+                auto_rho: true,
+                ..p.chebyshev
+            },
+            ..p
+        }
+    } else {
+        p
     };
     let mut world = World::new(p).unwrap();
     let e = R / 4.0;

@@ -75,7 +75,7 @@ pub struct PfParams {
     /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_PAPER`.
     pub omega2_rule: PfOmega2Rule,
     /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.98.
+    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.95.
     pub chebyshev_rho: f64,
     /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
     pub chebyshev_delay: u32,
@@ -88,7 +88,8 @@ pub struct PfParams {
     pub projection_weight: PfProjectionWeight,
     /// Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
     /// 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
-    /// most η. Default 2.5e-4.
+    /// most η and the last outer iteration moved no particle farther than
+    /// 10·`displacement_tolerance`. Default 2.5e-4.
     pub density_tolerance: f64,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
     /// outer iteration. Default 3e-3·r.

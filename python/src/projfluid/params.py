@@ -117,7 +117,8 @@ class Params:
     """Weighting of the local projection."""
     density_tolerance: float = _C_DEFAULTS.density_tolerance
     """Outer stopping threshold η on the average density error, a fraction in [0, 1): stop
-    when the mean of max(ρ/ρ0 − 1, 0) over the fluid is at most η (0 turns the rule off)."""
+    when the mean of max(ρ/ρ0 − 1, 0) over the fluid is at most η and the last outer iteration
+    moved no particle farther than 10 times ``displacement_tolerance`` (0 turns the rule off)."""
     displacement_tolerance: float = _C_DEFAULTS.displacement_tolerance
     """Outer stopping threshold τ (m): stop when no particle moved more than τ."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations

@@ -1,5 +1,6 @@
 //! The end of a step (docs/method.md §1.3): velocities from the positions, the new
-//! positions, densities at them (kept from the last local step where it evaluated them), the non-pressure forces, and the step's statistics.
+//! positions, densities at them (kept from the last local step where it evaluated them), the
+//! non-pressure forces, and the step's statistics.
 
 use super::StepBuffers;
 use super::iterate::Outcome;

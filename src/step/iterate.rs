@@ -1,7 +1,8 @@
 //! The outer local/global iteration of a step (docs/method.md §1.3, §3, §4): the system
 //! matrix of formulation F1 frozen for the step, then local projections and global solves
 //! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until the fluid's average
-//! compression is at most η or no particle moved farther than τ.
+//! compression is at most η (once no particle moves farther than 10τ) or no particle moved
+//! farther than τ.
 
 use super::{StepBuffers, couple};
 use crate::boundary::Boundary;

@@ -64,7 +64,7 @@ pub(super) fn predict(
 }
 
 /// The grid's slack on every side, as a fraction of the extent of what it covers: room for
-/// splashes before a rebuild, at the cost of empty cells (12 bytes each).
+/// splashes before a rebuild, at the cost of the memory of empty cells.
 const GRID_SLACK: f64 = 0.1;
 
 /// The neighbour grid, kept across steps, and whether it reached its cell limit.

@@ -214,7 +214,18 @@ impl DensityConstraint {
     pub fn membership(&self, nb: &NeighborLists, j: usize) -> f64 {
         match self.weight {
             ProjectionWeight::Uniform => self.rest_stencil_size,
-            _ => (nb.count(j) + 1) as f64,
+            _ => ((nb.count(j) + 1) as f64).max(self.membership_floor),
+        }
+    }
+
+    /// The factor M_j/(n_j + 1) ≥ 1 by which the global step scales the corrections gathered
+    /// for particle j (dimensionless): the membership floor stiffens a sparse particle's
+    /// pull towards its projections without moving their target (docs/method.md §3.1).
+    #[inline]
+    pub fn correction_scale(&self, nb: &NeighborLists, j: usize) -> f64 {
+        match self.weight {
+            ProjectionWeight::Uniform => 1.0,
+            _ => self.membership(nb, j) / (nb.count(j) + 1) as f64,
         }
     }
 }

@@ -20,6 +20,11 @@ use crate::kernel::CubicKernel;
 use crate::neighbors::NeighborLists;
 use crate::params::ProjectionWeight;
 
+/// The default [`DensityConstraint::membership_floor`]: particles with fewer than 15 fluid
+/// neighbours (spray, thin sheets) are counted in 16 stencils by the global step. Measured on
+/// `dam_break_30k` (docs/method.md §3.1): the largest density error of its 2 s fell from
+/// 14.2 % to 1.2 %, with fewer outer iterations.
+pub const MEMBERSHIP_FLOOR: f64 = 16.0;
 /// The local projection stops once C_i ≤ this value (Sommer et al. 2020, Weiler et al. 2016).
 const CONSTRAINT_GOAL: f64 = 1e-14;
 /// At most this many Newton-like steps per projection.
@@ -65,6 +70,10 @@ pub struct DensityConstraint {
     /// Stencil size c = ρ0·(4/3)πH³/m of a fluid at rest density (particles per stencil),
     /// the weight of [`ProjectionWeight::Uniform`].
     pub rest_stencil_size: f64,
+    /// The fewest stencils the global step counts a particle in (docs/method.md §3.1): a
+    /// particle with fewer fluid neighbours (spray) keeps a constraint as stiff, relative to
+    /// its mass, as one with this many. 1 or less: the reference behaviour.
+    pub membership_floor: f64,
     /// Write every projection's corrections out, as multi-step ones do (the reference path,
     /// for tests of the single-step shortcut).
     pub(crate) materialize_all: bool,
@@ -158,6 +167,7 @@ mod test_cluster {
             rest_density: 1000.0,
             weight: ProjectionWeight::NeighborCount,
             rest_stencil_size: 4.0 / 3.0 * std::f64::consts::PI * 8.0,
+            membership_floor: 1.0,
             materialize_all: false,
             portable: true,
             evaluate_first_step: true,

@@ -171,7 +171,8 @@ impl Coupling {
             let scale = dt2k / diagonal[j];
             self.keep
                 .push(constraint.membership(fluid_lists, j) * scale);
-            self.gain.push(weights[j] * scale);
+            let correction = constraint.correction_scale(fluid_lists, j);
+            self.gain.push(weights[j] * correction * scale);
         }
     }
 

@@ -133,7 +133,8 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
             constraint.gathered_corrections(first, current, &nb, projections, corrections, rhs);
             for (j, rhs) in (first..).zip(rhs) {
                 let members = constraint.membership(lists, j);
-                *rhs = predicted.at(j) * mass + (current[j] * members + *rhs) * dt2k;
+                let scale = constraint.correction_scale(lists, j);
+                *rhs = predicted.at(j) * mass + (current[j] * members + *rhs * scale) * dt2k;
             }
         };
         if single_sweep {

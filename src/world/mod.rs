@@ -22,7 +22,7 @@ pub use state::{GridParts, WorldState};
 
 use crate::body::Body;
 use crate::boundary::{Aabb, Boundary};
-use crate::constraint::DensityConstraint;
+use crate::constraint::{DensityConstraint, MEMBERSHIP_FLOOR};
 use crate::emitter::Emitter;
 use crate::fluid::Fluid;
 use crate::forces::{self, NonPressureForce};
@@ -89,6 +89,7 @@ impl World {
                 rest_density: params.rest_density,
                 weight: params.projection_weight,
                 rest_stencil_size: params.rest_stencil_size(),
+                membership_floor: MEMBERSHIP_FLOOR,
                 materialize_all: false,
                 portable: false,
                 evaluate_first_step: false,

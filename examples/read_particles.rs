@@ -46,6 +46,7 @@ fn main() -> Result<(), projfluid::Error> {
     if let Some(path) = std::env::args().nth(1) {
         projfluid::io::vtk::write_vtk(
             std::path::Path::new(&path),
+            world.time(),
             &world.positions(),
             &world.velocities(),
             &world.densities(),

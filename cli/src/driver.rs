@@ -86,10 +86,33 @@ impl From<RunError<std::convert::Infallible>> for Error {
 /// energy.
 pub struct Runner {
     length: RunLength,
+    /// Frames per simulated second whose times the steps land on (1/s).
+    landing: Option<f64>,
     datum: f64,
     start_time: f64,
     start_steps: u64,
     acc: RunAccumulator,
+}
+
+/// How the run's next step is sized.
+#[derive(Clone, Copy, Debug)]
+enum NextStep {
+    /// The CFL-limited size (s).
+    Cfl(f64),
+    /// Ending exactly at this time (s), a step of the size given second (s).
+    Until(f64, f64),
+}
+
+impl NextStep {
+    /// The CFL step, or, where it would pass `end` (s), the step that ends there.
+    fn land(world: &World, end: f64) -> Self {
+        let dt = world.next_dt();
+        if world.time() + dt >= end {
+            NextStep::Until(end, end - world.time())
+        } else {
+            NextStep::Cfl(dt)
+        }
+    }
 }
 
 /// One step taken by [`Runner::step`].
@@ -122,6 +145,7 @@ impl Runner {
         acc.record_energy(total_energy(world, datum));
         Ok(Self {
             length,
+            landing: None,
             datum,
             start_time: world.time(),
             start_steps: world.steps(),
@@ -129,28 +153,57 @@ impl Runner {
         })
     }
 
-    /// The step size (s) of the run's next step, or `None` once the run has reached its end.
-    fn next_dt(&self, world: &World) -> Option<f64> {
+    /// Lands the run's steps on every multiple of 1/`fps` seconds of simulated time: a step
+    /// that would pass one is shortened to end on it ([`frame_index`] tells which).
+    pub fn landing_on(mut self, fps: f64) -> Self {
+        self.landing = Some(fps);
+        self
+    }
+
+    /// The run's next step, or `None` once the run has reached its end.
+    fn next_step(&self, world: &World) -> Option<NextStep> {
+        let now = world.time();
         let until = |end: f64| {
-            let left = end - world.time();
-            (left > 1e-12 * end.abs().max(1.0)).then(|| world.next_dt().min(left))
+            let left = end - now;
+            (left > 1e-12 * end.abs().max(1.0)).then(|| NextStep::land(world, end))
         };
-        match self.length {
-            RunLength::Steps(n) => (self.acc.steps() < n).then(|| world.next_dt()),
-            RunLength::UntilStep(n) => (world.steps() < n).then(|| world.next_dt()),
+        let step = match self.length {
+            RunLength::Steps(n) => (self.acc.steps() < n).then(|| NextStep::Cfl(world.next_dt())),
+            RunLength::UntilStep(n) => (world.steps() < n).then(|| NextStep::Cfl(world.next_dt())),
             RunLength::Duration(d) => until(self.start_time + d),
             RunLength::UntilTime(end) => until(end),
-        }
+        }?;
+        let Some(fps) = self.landing else {
+            return Some(step);
+        };
+        let next = match frame_index(now, fps) {
+            Some(k) => k + 1,
+            None => (now * fps).ceil() as u64,
+        };
+        let frame = next as f64 / fps;
+        Some(match step {
+            // A step ending within the frame tolerance before the frame lands on it too.
+            NextStep::Cfl(dt) | NextStep::Until(_, dt)
+                if now + dt > frame - FRAME_TOLERANCE / fps =>
+            {
+                NextStep::Until(frame, frame - now)
+            }
+            step => step,
+        })
     }
 
     /// Takes the run's next step of `world` (the world it started with), or returns `None`
     /// once the run has reached its end.
     pub fn step(&mut self, world: &mut World) -> Result<Option<StepTaken>, Error> {
-        let Some(dt) = self.next_dt(world) else {
+        let Some(next) = self.next_step(world) else {
             return Ok(None);
         };
         let (clock, cpu) = (Instant::now(), process_cpu_seconds());
-        let stats = world.step_with_dt(dt)?.clone();
+        let stats = match next {
+            NextStep::Cfl(dt) => world.step_with_dt(dt)?,
+            NextStep::Until(end, _) => world.step_until(end)?,
+        }
+        .clone();
         let wall_seconds = clock.elapsed().as_secs_f64();
         let cpu_seconds = cpu.zip(process_cpu_seconds()).map(|(a, b)| b - a);
         let acc = &mut self.acc;
@@ -189,16 +242,41 @@ impl Runner {
     }
 }
 
+/// How close to a frame's time, in frame intervals, the clock counts as standing on it.
+const FRAME_TOLERANCE: f64 = 1e-6;
+
+/// The index k of the frame whose time k/`fps` the clock `time` (s) stands on, if any:
+/// within [`FRAME_TOLERANCE`] of a frame interval (a run's steps land on frame times
+/// exactly; the tolerance is for clocks set otherwise).
+pub fn frame_index(time: f64, fps: f64) -> Option<u64> {
+    let k = (time * fps).round();
+    ((time * fps - k).abs() <= FRAME_TOLERANCE && k >= 0.0).then_some(k as u64)
+}
+
 /// Runs `world` for `length` with a [`Runner`], calling `on_step` after every step, and
 /// returns the statistics of the steps taken. Stops at the first failing step or callback
 /// error.
 pub fn run<E>(
     world: &mut World,
     length: RunLength,
+    on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
+) -> Result<RunAccumulator, RunError<E>> {
+    run_landing(world, length, None, on_step)
+}
+
+/// [`run`], its steps landing on every multiple of 1/`fps` seconds where `fps` is given
+/// ([`Runner::landing_on`]).
+pub fn run_landing<E>(
+    world: &mut World,
+    length: RunLength,
+    fps: Option<f64>,
     mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
 ) -> Result<RunAccumulator, RunError<E>> {
     let mut runner =
         Runner::new(world, length).map_err(|error| RunError::Step { step: 1, error })?;
+    if let Some(fps) = fps {
+        runner = runner.landing_on(fps);
+    }
     loop {
         let taken = match runner.step(world) {
             Ok(Some(taken)) => taken,

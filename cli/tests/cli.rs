@@ -213,7 +213,8 @@ fn short_run_writes_stats_and_frames() {
             "frame_00000.vtk",
             "frame_00001.vtk",
             "frame_00002.vtk",
-            "frame_00003.vtk"
+            "frame_00003.vtk",
+            "frames.csv"
         ]
     );
     let last = std::fs::read(frames.join("frame_00003.vtk")).unwrap();
@@ -221,6 +222,141 @@ fn short_run_writes_stats_and_frames() {
     assert!(
         last.windows(b"POINTS 3840 float".len())
             .any(|w| w == b"POINTS 3840 float")
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The TIME field of a binary VTK frame written by `projfluid run` (s).
+fn vtk_time(path: &Path) -> f64 {
+    let bytes = std::fs::read(path).unwrap();
+    let key = b"TIME 1 1 double\n";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("TIME")
+        + key.len();
+    f64::from_be_bytes(bytes[at..at + 8].try_into().unwrap())
+}
+
+/// The `comment time` of a PLY frame (s).
+fn ply_time(path: &Path) -> f64 {
+    let bytes = std::fs::read(path).unwrap();
+    let text = String::from_utf8_lossy(&bytes[..bytes.len().min(400)]).into_owned();
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("comment time "))
+        .expect("time");
+    line["comment time ".len()..].parse().unwrap()
+}
+
+/// With `--fps` the frames land on the multiples of 1/fps exactly, and `frames.csv`, the
+/// frames' TIME fields and the summary's simulated time agree; with `--every` the frames
+/// carry the times of their steps, which `frames.csv` lists too. A resumed run continues the
+/// index where the checkpoint stood.
+#[test]
+fn frames_carry_their_simulated_times() {
+    let dir = temp_dir("frame-times");
+    let (frames, stats) = (dir.join("frames"), dir.join("stats.json"));
+    let (frames_arg, stats_arg) = (frames.to_str().unwrap(), stats.to_str().unwrap());
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--duration",
+        "0.09",
+        "--fps",
+        "50",
+        "--out",
+        frames_arg,
+        "--stats",
+        stats_arg,
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (header, rows) = read_csv(&frames.join("frames.csv"));
+    assert_eq!(header, ["frame", "step", "time"]);
+    // Frames at 0, 0.02, …, 0.08; the run ends at 0.09, between frames.
+    assert_eq!(rows.len(), 5);
+    let mut last_step = -1.0;
+    for (k, row) in rows.iter().enumerate() {
+        let time = number(&header, row, "time");
+        assert_eq!(row[0], k.to_string());
+        assert_eq!(time, k as f64 / 50.0, "frame {k}");
+        assert_eq!(vtk_time(&frames.join(format!("frame_{k:05}.vtk"))), time);
+        let step = number(&header, row, "step");
+        assert!(step > last_step, "steps rise: {rows:?}");
+        last_step = step;
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(json["sim_time"], 0.09);
+    assert!(json["steps"].as_f64().unwrap() > last_step, "{json}");
+
+    let ply = dir.join("ply");
+    let checkpoints = dir.join("checkpoints");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "6",
+        "--every",
+        "2",
+        "--format",
+        "ply",
+        "--out",
+        ply.to_str().unwrap(),
+        "--checkpoint-every",
+        "4",
+        "--checkpoint-dir",
+        checkpoints.to_str().unwrap(),
+        "--stats",
+        stats_arg,
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (header, rows) = read_csv(&ply.join("frames.csv"));
+    assert_eq!(rows.len(), 4);
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(number(&header, row, "step"), 2.0 * k as f64);
+        let time = number(&header, row, "time");
+        assert_eq!(ply_time(&ply.join(format!("frame_{k:05}.ply"))), time);
+    }
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(
+        number(&header, &rows[3], "time"),
+        json["sim_time"].as_f64().unwrap()
+    );
+    let full = std::fs::read_to_string(ply.join("frames.csv")).unwrap();
+    // Resuming from step 4 keeps frames 0–2 and writes frame 3 (step 6) again, bit for bit.
+    let checkpoint = checkpoints.join("checkpoint_000004.pfck");
+    let out = projfluid(&[
+        "run",
+        "--resume",
+        checkpoint.to_str().unwrap(),
+        "--every",
+        "2",
+        "--format",
+        "ply",
+        "--out",
+        ply.to_str().unwrap(),
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(ply.join("frames.csv")).unwrap(),
+        full
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -532,7 +668,12 @@ fn png_pictures_are_written_at_the_frame_interval() {
     names.sort();
     assert_eq!(
         names,
-        ["frame_00000.png", "frame_00001.png", "frame_00002.png"]
+        [
+            "frame_00000.png",
+            "frame_00001.png",
+            "frame_00002.png",
+            "frames.csv"
+        ]
     );
     let decoder = png::Decoder::new(std::fs::File::open(pictures.join("frame_00002.png")).unwrap());
     let mut reader = decoder.read_info().unwrap();

@@ -1,27 +1,31 @@
 //! Frames as PLY point clouds (binary little-endian), readable by Blender, MeshLab and
-//! CloudCompare: one `vertex` element per particle with `float` properties `x y z` (m),
-//! `vx vy vz` (m/s) and `density` (kg/m³).
+//! CloudCompare: the simulated time in a header comment `comment time T` (s, printed so that
+//! it reads back exactly), and one `vertex` element per particle with `float` properties
+//! `x y z` (m), `vx vy vz` (m/s) and `density` (kg/m³).
 
 use crate::{Error, Vec3};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Writes one frame: `positions` (m), `velocities` (m/s) and `densities` (kg/m³), one entry
-/// per particle, as little-endian 32-bit floats. Creates or truncates `path`. Errors name
-/// the path, or the argument whose length differs from `positions`.
+/// Writes one frame at simulated time `time` (s): `positions` (m), `velocities` (m/s) and
+/// `densities` (kg/m³), one entry per particle, as little-endian 32-bit floats. Creates or
+/// truncates `path`. Errors name the path, or the argument whose length differs from
+/// `positions`, or a time that is not finite.
 pub fn write_ply(
     path: &Path,
+    time: f64,
     positions: &[Vec3],
     velocities: &[Vec3],
     densities: &[f64],
 ) -> Result<(), Error> {
-    super::check_lengths(positions.len(), velocities, densities)?;
+    super::check_frame(time, positions.len(), velocities, densities)?;
     let fail = |e: std::io::Error| Error::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = BufWriter::new(File::create(path).map_err(fail)?);
     write!(
         w,
-        "ply\nformat binary_little_endian 1.0\ncomment projfluid frame\nelement vertex {}\n\
+        "ply\nformat binary_little_endian 1.0\ncomment projfluid frame\ncomment time {time}\n\
+         element vertex {}\n\
          property float x\nproperty float y\nproperty float z\n\
          property float vx\nproperty float vy\nproperty float vz\n\
          property float density\nend_header\n",
@@ -73,7 +77,8 @@ mod tests {
         let velocities = vec![Vec3::new(1.0, -2.0, 0.5), Vec3::new(0.333, 1e3, -7.0)];
         let densities = vec![1000.0, 998.25];
         let path = std::env::temp_dir().join(format!("projfluid-ply-{}.ply", std::process::id()));
-        write_ply(&path, &positions, &velocities, &densities).unwrap();
+        let time = 0.1 + 0.2;
+        write_ply(&path, time, &positions, &velocities, &densities).unwrap();
         let bytes = std::fs::read(&path).unwrap();
         std::fs::remove_file(&path).unwrap();
         let (header, records) = read_ply(&bytes);
@@ -83,6 +88,7 @@ mod tests {
                 "ply",
                 "format binary_little_endian 1.0",
                 "comment projfluid frame",
+                "comment time 0.30000000000000004",
                 "element vertex 2",
                 "property float x",
                 "property float y",
@@ -94,6 +100,7 @@ mod tests {
                 "end_header"
             ]
         );
+        assert_eq!(header[3]["comment time ".len()..].parse::<f64>(), Ok(time));
         assert_eq!(records.len(), 2);
         for i in 0..2 {
             let (x, v) = (positions[i], velocities[i]);
@@ -105,12 +112,12 @@ mod tests {
     #[test]
     fn bad_lengths_and_paths_are_named() {
         let p = [Vec3::zeros(); 2];
-        let err = write_ply(Path::new("/tmp/x.ply"), &p, &p, &[0.0]).unwrap_err();
+        let err = write_ply(Path::new("/tmp/x.ply"), 0.0, &p, &p, &[0.0]).unwrap_err();
         assert_eq!(
             err.to_string(),
             "densities must have one entry per position (2), got 1"
         );
-        let err = write_ply(Path::new("/nonexistent/f.ply"), &[], &[], &[]).unwrap_err();
+        let err = write_ply(Path::new("/nonexistent/f.ply"), 0.0, &[], &[], &[]).unwrap_err();
         assert!(err.to_string().contains("/nonexistent/f.ply"), "{err}");
     }
 }

@@ -1,23 +1,55 @@
-//! Frames as legacy VTK files (binary, big-endian `float`), readable by ParaView and VisIt:
-//! `DATASET POLYDATA` with the particle centres as `POINTS`, one vertex cell per particle (so
-//! the points render), and per-point `velocity` (m/s) and `density` (kg/m³).
+//! Frames as legacy VTK files, readable by ParaView and VisIt: `DATASET POLYDATA` with the
+//! simulated time as a `TIME` field (which ParaView and VisIt read as the frame's time), the
+//! particle centres as `POINTS`, one vertex cell per particle (so the points render), and
+//! per-point `velocity` (m/s) and `density` (kg/m³). Binary files store big-endian `float`s
+//! (the time as a `double`); ASCII files write the same values as text.
 
 use crate::{Error, Vec3};
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Writes one frame: `positions` (m), `velocities` (m/s) and `densities` (kg/m³), one entry
-/// per particle, stored as big-endian 32-bit floats. Creates or truncates `path`.
-/// Errors name the path, or the argument whose length differs from `positions`.
+/// How a VTK file stores its numbers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VtkEncoding {
+    /// Big-endian binary: compact and exact to f32 (the time to f64).
+    Binary,
+    /// Text: readable by any tool, the same values printed as decimals.
+    Ascii,
+}
+
+/// Writes one binary frame at simulated time `time` (s): `positions` (m), `velocities`
+/// (m/s) and `densities` (kg/m³), one entry per particle, stored as big-endian 32-bit
+/// floats. Creates or truncates `path`. Errors name the path, or the argument whose length
+/// differs from `positions`, or a time that is not finite.
 pub fn write_vtk(
     path: &Path,
+    time: f64,
+    positions: &[Vec3],
+    velocities: &[Vec3],
+    densities: &[f64],
+) -> Result<(), Error> {
+    write_vtk_encoded(
+        path,
+        VtkEncoding::Binary,
+        time,
+        positions,
+        velocities,
+        densities,
+    )
+}
+
+/// [`write_vtk`] with the numbers stored as `encoding` says.
+pub fn write_vtk_encoded(
+    path: &Path,
+    encoding: VtkEncoding,
+    time: f64,
     positions: &[Vec3],
     velocities: &[Vec3],
     densities: &[f64],
 ) -> Result<(), Error> {
     let n = positions.len();
-    super::check_lengths(n, velocities, densities)?;
+    super::check_frame(time, n, velocities, densities)?;
     if n > (i32::MAX / 2) as usize {
         return Err(Error::invalid(
             "positions",
@@ -28,45 +60,98 @@ pub fn write_vtk(
     let fail = |e: std::io::Error| Error::Io(format!("cannot write {}: {e}", path.display()));
     let file = File::create(path).map_err(fail)?;
     let mut w = BufWriter::new(file);
-    write_frame(&mut w, positions, velocities, densities).map_err(fail)?;
+    let mut frame = Frame {
+        w: &mut w,
+        encoding,
+    };
+    frame
+        .write(time, positions, velocities, densities)
+        .map_err(fail)?;
     w.flush().map_err(fail)
 }
 
-/// The file's bytes, in order.
-fn write_frame(
-    w: &mut impl Write,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> std::io::Result<()> {
-    let n = positions.len();
-    write!(
-        w,
-        "# vtk DataFile Version 3.0\nprojfluid frame\nBINARY\nDATASET POLYDATA\nPOINTS {n} float\n"
-    )?;
-    write_vectors(w, positions)?;
-    write!(w, "\nVERTICES {n} {}\n", 2 * n)?;
-    for i in 0..n as i32 {
-        w.write_all(&1i32.to_be_bytes())?;
-        w.write_all(&i.to_be_bytes())?;
-    }
-    write!(w, "\nPOINT_DATA {n}\nVECTORS velocity float\n")?;
-    write_vectors(w, velocities)?;
-    write!(w, "\nSCALARS density float 1\nLOOKUP_TABLE default\n")?;
-    for &d in densities {
-        w.write_all(&(d as f32).to_be_bytes())?;
-    }
-    writeln!(w)
+/// A frame being written in one encoding.
+struct Frame<'a, W: Write> {
+    w: &'a mut W,
+    encoding: VtkEncoding,
 }
 
-/// Three big-endian f32 per vector.
-fn write_vectors(w: &mut impl Write, vectors: &[Vec3]) -> std::io::Result<()> {
-    for v in vectors {
-        for c in v.iter() {
-            w.write_all(&(*c as f32).to_be_bytes())?;
+impl<W: Write> Frame<'_, W> {
+    /// The file's bytes, in order.
+    fn write(
+        &mut self,
+        time: f64,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        densities: &[f64],
+    ) -> std::io::Result<()> {
+        let n = positions.len();
+        let name = match self.encoding {
+            VtkEncoding::Binary => "BINARY",
+            VtkEncoding::Ascii => "ASCII",
+        };
+        write!(
+            self.w,
+            "# vtk DataFile Version 3.0\nprojfluid frame\n{name}\nDATASET POLYDATA\n\
+             FIELD FieldData 1\nTIME 1 1 double\n"
+        )?;
+        match self.encoding {
+            VtkEncoding::Binary => self.w.write_all(&time.to_be_bytes())?,
+            VtkEncoding::Ascii => write!(self.w, "{time:e}")?,
+        }
+        write!(self.w, "\nPOINTS {n} float\n")?;
+        self.vectors(positions)?;
+        write!(self.w, "\nVERTICES {n} {}\n", 2 * n)?;
+        for i in 0..n as i32 {
+            self.int(1)?;
+            self.int(i)?;
+            self.separate()?;
+        }
+        write!(self.w, "\nPOINT_DATA {n}\nVECTORS velocity float\n")?;
+        self.vectors(velocities)?;
+        write!(self.w, "\nSCALARS density float 1\nLOOKUP_TABLE default\n")?;
+        for &d in densities {
+            self.float(d)?;
+            self.separate()?;
+        }
+        writeln!(self.w)
+    }
+
+    /// Three floats per vector.
+    fn vectors(&mut self, vectors: &[Vec3]) -> std::io::Result<()> {
+        for v in vectors {
+            for &c in v.iter() {
+                self.float(c)?;
+            }
+            self.separate()?;
+        }
+        Ok(())
+    }
+
+    /// One value as an f32.
+    fn float(&mut self, value: f64) -> std::io::Result<()> {
+        let value = value as f32;
+        match self.encoding {
+            VtkEncoding::Binary => self.w.write_all(&value.to_be_bytes()),
+            VtkEncoding::Ascii => write!(self.w, "{value:e} "),
         }
     }
-    Ok(())
+
+    /// One 32-bit integer.
+    fn int(&mut self, value: i32) -> std::io::Result<()> {
+        match self.encoding {
+            VtkEncoding::Binary => self.w.write_all(&value.to_be_bytes()),
+            VtkEncoding::Ascii => write!(self.w, "{value} "),
+        }
+    }
+
+    /// In ASCII, ends a record's line.
+    fn separate(&mut self) -> std::io::Result<()> {
+        match self.encoding {
+            VtkEncoding::Binary => Ok(()),
+            VtkEncoding::Ascii => writeln!(self.w),
+        }
+    }
 }
 
 #[cfg(test)]
@@ -129,7 +214,8 @@ mod tests {
         ];
         let densities = vec![1000.0, 998.25, 1012.5];
         let path = temp_path("frame.vtk");
-        write_vtk(&path, &positions, &velocities, &densities).unwrap();
+        let time = 0.1 + 0.2;
+        write_vtk(&path, time, &positions, &velocities, &densities).unwrap();
         let mut r = Reader {
             bytes: std::fs::read(&path).unwrap(),
             at: 0,
@@ -144,6 +230,12 @@ mod tests {
         assert_eq!(r.line(), "projfluid frame");
         assert_eq!(r.line(), "BINARY");
         assert_eq!(r.line(), "DATASET POLYDATA");
+        assert_eq!(r.line(), "FIELD FieldData 1");
+        assert_eq!(r.line(), "TIME 1 1 double");
+        let bytes: [u8; 8] = r.bytes[r.at..r.at + 8].try_into().unwrap();
+        r.at += 8;
+        assert_eq!(f64::from_be_bytes(bytes), time);
+        assert_eq!(r.line(), "");
         assert_eq!(r.line(), "POINTS 3 float");
         assert_eq!(r.floats(9), as_f32(&positions));
         assert_eq!(r.line(), "");
@@ -164,20 +256,68 @@ mod tests {
     #[test]
     fn mismatched_lengths_are_rejected() {
         let p = [Vec3::zeros(); 2];
-        let err = write_vtk(&temp_path("bad.vtk"), &p, &p[..1], &[0.0; 2]).unwrap_err();
+        let err = write_vtk(&temp_path("bad.vtk"), 0.0, &p, &p[..1], &[0.0; 2]).unwrap_err();
         assert_eq!(
             err.to_string(),
             "velocities must have one entry per position (2), got 1"
         );
+        let err = write_vtk(&temp_path("bad.vtk"), f64::NAN, &p, &p, &[0.0; 2]).unwrap_err();
+        assert_eq!(err.to_string(), "time must be finite, got NaN");
     }
 
     #[test]
     fn unwritable_path_is_named() {
         let path = Path::new("/nonexistent-dir/frame.vtk");
-        let err = write_vtk(path, &[], &[], &[]).unwrap_err();
+        let err = write_vtk(path, 0.0, &[], &[], &[]).unwrap_err();
         assert!(
             err.to_string().contains("/nonexistent-dir/frame.vtk"),
             "{err}"
         );
+    }
+
+    /// An ASCII frame holds the same sections with the values as text: the time exactly,
+    /// the rest as the f32 the binary file stores.
+    #[test]
+    fn ascii_frame_reads_back() {
+        let positions = vec![Vec3::new(0.1, 0.2, 0.3), Vec3::new(-1.5, 2.25, 1e-7)];
+        let velocities = vec![Vec3::new(1.0, -2.0, 0.5), Vec3::zeros()];
+        let densities = vec![1000.0, 998.25];
+        let path = temp_path("ascii.vtk");
+        let time = 1.0 / 3.0;
+        let encoding = VtkEncoding::Ascii;
+        write_vtk_encoded(&path, encoding, time, &positions, &velocities, &densities).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let mut lines = text.lines().filter(|l| !l.trim().is_empty());
+        let mut expect = |wanted: &str| assert_eq!(lines.next(), Some(wanted));
+        expect("# vtk DataFile Version 3.0");
+        expect("projfluid frame");
+        expect("ASCII");
+        expect("DATASET POLYDATA");
+        expect("FIELD FieldData 1");
+        expect("TIME 1 1 double");
+        let rest: Vec<&str> = lines.collect();
+        assert_eq!(rest[0].parse::<f64>(), Ok(time));
+        assert_eq!(rest[1], "POINTS 2 float");
+        let numbers = |line: &str| -> Vec<f32> {
+            line.split_whitespace()
+                .map(|v| v.parse().unwrap())
+                .collect()
+        };
+        let as_f32 = |v: &Vec3| v.iter().map(|&c| c as f32).collect::<Vec<_>>();
+        assert_eq!(numbers(rest[2]), as_f32(&positions[0]));
+        assert_eq!(numbers(rest[3]), as_f32(&positions[1]));
+        assert_eq!(rest[4], "VERTICES 2 4");
+        assert_eq!(rest[5].trim(), "1 0");
+        assert_eq!(rest[6].trim(), "1 1");
+        assert_eq!(rest[7], "POINT_DATA 2");
+        assert_eq!(rest[8], "VECTORS velocity float");
+        assert_eq!(numbers(rest[9]), as_f32(&velocities[0]));
+        assert_eq!(numbers(rest[10]), as_f32(&velocities[1]));
+        assert_eq!(rest[11], "SCALARS density float 1");
+        assert_eq!(rest[12], "LOOKUP_TABLE default");
+        assert_eq!(numbers(rest[13]), [1000.0]);
+        assert_eq!(numbers(rest[14]), [998.25]);
+        assert_eq!(rest.len(), 15);
     }
 }

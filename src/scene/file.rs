@@ -87,6 +87,8 @@ struct TimeFile {
 struct OutputFile {
     dir: Option<String>,
     every: Option<usize>,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    fps: Option<f64>,
 }
 
 /// `solver.rho`: a number in [0, 1), or `"auto"` for the online estimate.
@@ -249,6 +251,7 @@ impl SceneFile {
             output: OutputSpec {
                 dir: o.dir.map(PathBuf::from),
                 every: o.every.unwrap_or(super::DEFAULT_OUTPUT_EVERY),
+                fps: o.fps,
             },
         })
     }
@@ -313,6 +316,7 @@ impl SceneFile {
                     .as_ref()
                     .map(|d| d.to_string_lossy().into_owned()),
                 every: Some(scene.output.every),
+                fps: scene.output.fps,
             }),
         }
     }

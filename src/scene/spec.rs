@@ -96,8 +96,11 @@ pub struct OutputSpec {
     /// Directory for VTK frames (`None`: no frames); relative paths are relative to the
     /// working directory.
     pub dir: Option<PathBuf>,
-    /// A frame every this many steps (≥ 1; default 10).
+    /// A frame every this many steps (≥ 1; default 10), unless `fps` is set.
     pub every: usize,
+    /// Frames per simulated second (1/s, positive): a frame at every multiple of 1/fps,
+    /// the step before each shortened to land on it; replaces `every`.
+    pub fps: Option<f64>,
 }
 
 /// Default number of steps between frames.
@@ -108,6 +111,7 @@ impl Default for OutputSpec {
         Self {
             dir: None,
             every: DEFAULT_OUTPUT_EVERY,
+            fps: None,
         }
     }
 }

@@ -35,6 +35,18 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
             "must be at least 1",
         ));
     }
+    if let Some(fps) = scene.output.fps
+        && !(fps.is_finite() && fps > 0.0 && 1.0 / fps >= scene.params.dt_min)
+    {
+        return Err(Error::invalid(
+            "output.fps",
+            fps,
+            &format!(
+                "must be positive and at most 1/dt_min ({} frames per second)",
+                1.0 / scene.params.dt_min
+            ),
+        ));
+    }
     for (i, c) in scene.containers.iter().enumerate() {
         check_container(i, c, r)?;
     }
@@ -325,6 +337,14 @@ mod tests {
     #[test]
     fn bad_values_name_the_json_key() {
         let cases = [
+            (
+                "\"output\": {\"fps\": 0}",
+                "output.fps must be positive and at most 1/dt_min (10000 frames per second), got 0",
+            ),
+            (
+                "\"output\": {\"fps\": 20000}",
+                "output.fps must be positive and at most 1/dt_min (10000 frames per second), got 20000",
+            ),
             (
                 "\"solver\": {\"rho\": 1.5}",
                 "solver.rho must lie in [0, 1), got 1.5",

@@ -55,6 +55,25 @@ impl World {
         Ok(self.take_prepared_step(dt))
     }
 
+    /// Takes one step that ends at simulated time `end` (s) exactly: a step of
+    /// `end` − [`World::time`] seconds (checked as [`World::step_with_dt`] checks its `dt`),
+    /// after which the clock reads `end` without the round-off of adding the step's size.
+    /// For landing on output times and run ends. Errors, changing nothing: as
+    /// [`World::step_with_dt`], and an `end` that is not after the current time.
+    pub fn step_until(&mut self, end: f64) -> Result<&StepStats, Error> {
+        let dt = end - self.time;
+        if dt.is_nan() || dt <= 0.0 {
+            return Err(Error::invalid(
+                "end",
+                end,
+                &format!("must be after the current time ({} s)", self.time),
+            ));
+        }
+        self.step_with_dt(dt)?;
+        self.time = end;
+        Ok(self.last.as_ref().expect("a step was taken"))
+    }
+
     /// Checks that steps spanning the next `seconds` (s; 0 for one step) can be taken and
     /// reserves the storage they need, changing nothing observable.
     fn prepare_steps(&mut self, seconds: f64) -> Result<(), Error> {

@@ -461,3 +461,32 @@ fn spray_hitting_a_wall_stays_nearly_incompressed() {
         }
     }
 }
+
+/// `step_until` ends the step with the clock on the requested time exactly, where adding the
+/// step's size would be off by the round-off; an end not after the clock is rejected and
+/// changes nothing.
+#[test]
+fn step_until_lands_on_the_requested_time() {
+    let mut world = World::new(Params::default()).unwrap();
+    let container = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.5),
+    };
+    world.add_container(container, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(0.1), [3, 2, 2], Vec3::zeros())
+        .unwrap();
+    world.step_with_dt(0.0003).unwrap();
+    world.step_with_dt(0.0003).unwrap();
+    let end = 0.0017;
+    let dt = end - world.time();
+    assert_ne!(world.time() + dt, end, "the plain sum must miss here");
+    world.step_until(end).unwrap();
+    assert_eq!(world.time(), end);
+    let steps = world.steps();
+    for bad in [end, end - 1e-4, f64::NAN] {
+        let err = world.step_until(bad).unwrap_err();
+        assert!(err.to_string().starts_with("end must be after"), "{err}");
+    }
+    assert_eq!((world.time(), world.steps()), (end, steps));
+}

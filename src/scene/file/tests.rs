@@ -47,7 +47,7 @@ fn every_key_is_read() {
                        "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
             "viscosity": 0.02, "threads": 2, "duration": 3,
-            "output": {"dir": "frames", "every": 5}
+            "output": {"dir": "frames", "every": 5, "fps": 25}
         }"#;
     let s = Scene::from_json(text).unwrap();
     let p = &s.params;
@@ -80,6 +80,7 @@ fn every_key_is_read() {
     assert_eq!(s.description, "every key");
     assert_eq!(s.output.dir.as_deref(), Some(Path::new("frames")));
     assert_eq!(s.output.every, 5);
+    assert_eq!(s.output.fps, Some(25.0));
 }
 
 #[test]
@@ -200,6 +201,7 @@ fn documented_example_is_valid() {
     expected.output = OutputSpec {
         dir: Some(PathBuf::from("frames")),
         every: 20,
+        fps: None,
     };
     assert_eq!(scene, expected);
 }

@@ -1,5 +1,6 @@
 //! Numbered outputs of a run: data frames (VTK or PLY) and PNG pictures, written at the
-//! start and every N steps.
+//! start and then every N steps or at every multiple of 1/fps seconds, each carrying its
+//! simulated time; beside them `frames.csv` lists every frame's number, step and time.
 
 use crate::Failure;
 use projfluid::World;
@@ -16,11 +17,23 @@ pub(crate) enum FrameFormat {
     Ply,
 }
 
-/// Where frames and pictures go, and how many have been written.
+/// The name of the index written beside the frames.
+const INDEX: &str = "frames.csv";
+
+/// One written frame: its number, the world's step count and its simulated time (s).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Entry {
+    frame: usize,
+    step: u64,
+    time: f64,
+}
+
+/// Where frames and pictures go, and what has been written.
 pub(crate) struct Frames {
     data: Option<(PathBuf, FrameFormat)>,
     pictures: Option<(PathBuf, Renderer)>,
     written: usize,
+    index: Vec<Entry>,
 }
 
 /// Creates `dir` if needed.
@@ -53,25 +66,43 @@ impl Frames {
                 None => None,
             },
             written: 0,
+            index: Vec::new(),
         })
     }
 
     /// Numbers the next frame `index + 1`, as when frames 0..=index were written by an
-    /// earlier run that this one continues.
-    pub(crate) fn continue_after(&mut self, index: u64) {
+    /// earlier run that this one continues; the earlier run's index rows up to that frame
+    /// are kept.
+    pub(crate) fn continue_after(&mut self, index: u64) -> Result<(), Failure> {
         self.written = index as usize + 1;
+        let dir = self.dirs().next().map(Path::to_path_buf);
+        if let Some(dir) = dir {
+            self.index = read_index(&dir.join(INDEX))?
+                .into_iter()
+                .filter(|e| e.frame < self.written)
+                .collect();
+        }
+        Ok(())
+    }
+
+    /// The directories that receive frames.
+    fn dirs(&self) -> impl Iterator<Item = &Path> {
+        let data = self.data.as_ref().map(|(d, _)| d.as_path());
+        data.into_iter()
+            .chain(self.pictures.as_ref().map(|(d, _)| d.as_path()))
     }
 
     /// Writes the world's current state as the next frame.
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
         let name = format!("frame_{:05}", self.written);
         if let Some((dir, format)) = &self.data {
-            let (write, extension): (fn(_, _, _, _) -> _, _) = match format {
+            let (write, extension): (fn(_, _, _, _, _) -> _, _) = match format {
                 FrameFormat::Vtk => (write_vtk, "vtk"),
                 FrameFormat::Ply => (write_ply, "ply"),
             };
             write(
                 &dir.join(format!("{name}.{extension}")),
+                world.time(),
                 &world.positions(),
                 &world.velocities(),
                 &world.densities(),
@@ -84,7 +115,57 @@ impl Frames {
                 .write_png(&dir.join(format!("{name}.png")))
                 .map_err(|e| Failure::Runtime(e.to_string()))?;
         }
+        self.index.push(Entry {
+            frame: self.written,
+            step: world.steps(),
+            time: world.time(),
+        });
+        let text = index_text(&self.index);
+        for dir in self.dirs() {
+            let path = dir.join(INDEX);
+            std::fs::write(&path, &text)
+                .map_err(|e| Failure::Runtime(format!("cannot write {}: {e}", path.display())))?;
+        }
         self.written += 1;
         Ok(())
     }
+}
+
+/// The index file's text: a header line, then `frame,step,time` per frame, the time (s)
+/// printed so that it reads back exactly.
+fn index_text(entries: &[Entry]) -> String {
+    let mut text = String::from("frame,step,time\n");
+    for e in entries {
+        text += &format!("{},{},{}\n", e.frame, e.step, e.time);
+    }
+    text
+}
+
+/// The entries of an index file written by [`index_text`]; none if there is no file.
+fn read_index(path: &Path) -> Result<Vec<Entry>, Failure> {
+    let text = match std::fs::read_to_string(path) {
+        Ok(text) => text,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) => {
+            return Err(Failure::Runtime(format!(
+                "cannot read {}: {e}",
+                path.display()
+            )));
+        }
+    };
+    let bad =
+        |n: usize| Failure::Input(format!("{} line {n}: not frame,step,time", path.display()));
+    text.lines()
+        .enumerate()
+        .skip(1)
+        .map(|(n, line)| {
+            let mut fields = line.split(',');
+            let mut next = || fields.next().ok_or_else(|| bad(n + 1));
+            Ok(Entry {
+                frame: next()?.parse().map_err(|_| bad(n + 1))?,
+                step: next()?.parse().map_err(|_| bad(n + 1))?,
+                time: next()?.parse().map_err(|_| bad(n + 1))?,
+            })
+        })
+        .collect()
 }

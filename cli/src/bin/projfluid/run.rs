@@ -69,8 +69,12 @@ pub(crate) struct RunArgs {
     #[arg(long, value_name = "PIXELS", default_value_t = 640)]
     png_width: usize,
     /// Write a frame (and picture) every N steps, and the initial state as frame 0.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", conflicts_with = "fps")]
     every: Option<usize>,
+    /// Write a frame (and picture) at every multiple of 1/N seconds of simulated time,
+    /// shortening the step before each to land on it, instead of every N steps.
+    #[arg(long, value_name = "N")]
+    fps: Option<f64>,
     /// Write the run summary as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats: Option<PathBuf>,
@@ -145,7 +149,7 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         )),
         None => None,
     };
-    let every = scene.output.every as u64;
+    let (every, fps) = (scene.output.every as u64, scene.output.fps);
     let mut frames = Frames::new(
         scene.output.dir.as_deref(),
         args.format,
@@ -153,8 +157,12 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         &world,
     )?;
     if args.resume.is_some() {
-        // Frame k holds step k·every; the frames up to now were written before.
-        frames.continue_after(world.steps() / every);
+        // Frame k holds step k·every, or time k/fps; the frames up to now were written before.
+        let last = match fps {
+            Some(fps) => (world.time() * fps + 1e-6).floor() as u64,
+            None => world.steps() / every,
+        };
+        frames.continue_after(last)?;
     } else {
         frames.write(&world)?;
     }
@@ -175,9 +183,13 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         RunEnd::Time(end) => RunLength::UntilTime(end),
         RunEnd::Steps(n) => RunLength::UntilStep(n),
     };
-    let acc = driver::run(&mut world, length, |report| {
+    let acc = driver::run_landing(&mut world, length, fps, |report| {
         let world = report.world;
-        if world.steps() % every == 0 {
+        let due = match fps {
+            Some(fps) => driver::frame_index(world.time(), fps).is_some(),
+            None => world.steps() % every == 0,
+        };
+        if due {
             frames.write(world)?;
         }
         if let Some(n) = args.checkpoint_every
@@ -224,6 +236,10 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
     args.params.apply(scene);
     if let Some(every) = args.every {
         scene.output.every = every;
+        scene.output.fps = None;
+    }
+    if let Some(fps) = args.fps {
+        scene.output.fps = Some(fps);
     }
     if let Some(dir) = &args.out {
         scene.output.dir = Some(dir.clone());
@@ -249,6 +265,7 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
     let mut options = args.params.keys().to_vec();
     options.extend([
         ("output.every", "--every", args.every.is_some()),
+        ("output.fps", "--fps", args.fps.is_some()),
         ("duration", "--duration", args.duration.is_some()),
     ]);
     validate_naming_options(scene, &options)?;

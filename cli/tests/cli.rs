@@ -295,6 +295,39 @@ fn frames_carry_their_simulated_times() {
     assert_eq!(json["sim_time"], 0.09);
     assert!(json["steps"].as_f64().unwrap() > last_step, "{json}");
 
+    let ascii = dir.join("ascii");
+    let out = projfluid(&[
+        "run",
+        "dam_break_small",
+        "--steps",
+        "2",
+        "--every",
+        "2",
+        "--format",
+        "vtk-ascii",
+        "--out",
+        ascii.to_str().unwrap(),
+        "--stats",
+        stats_arg,
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(ascii.join("frame_00001.vtk")).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines[2], "ASCII");
+    assert_eq!(lines[5], "TIME 1 1 double");
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(
+        lines[6].parse::<f64>().unwrap(),
+        json["sim_time"].as_f64().unwrap()
+    );
+    assert!(lines.contains(&"POINTS 3840 float"));
+
     let ply = dir.join("ply");
     let checkpoints = dir.join("checkpoints");
     let out = projfluid(&[

@@ -4,7 +4,7 @@
 
 use crate::Failure;
 use projfluid::World;
-use projfluid::io::{write_ply, write_vtk};
+use projfluid::io::{VtkEncoding, write_ply, write_vtk_encoded};
 use projfluid_lab::render::Renderer;
 use std::path::{Path, PathBuf};
 
@@ -13,6 +13,8 @@ use std::path::{Path, PathBuf};
 pub(crate) enum FrameFormat {
     /// Legacy VTK polydata (ParaView, VisIt).
     Vtk,
+    /// Legacy VTK polydata as text (larger; readable by any tool).
+    VtkAscii,
     /// Binary PLY point cloud (Blender, MeshLab).
     Ply,
 }
@@ -96,17 +98,18 @@ impl Frames {
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
         let name = format!("frame_{:05}", self.written);
         if let Some((dir, format)) = &self.data {
-            let (write, extension): (fn(_, _, _, _, _) -> _, _) = match format {
-                FrameFormat::Vtk => (write_vtk, "vtk"),
-                FrameFormat::Ply => (write_ply, "ply"),
-            };
-            write(
-                &dir.join(format!("{name}.{extension}")),
+            let (time, x, v, rho) = (
                 world.time(),
-                &world.positions(),
-                &world.velocities(),
-                &world.densities(),
-            )
+                world.positions(),
+                world.velocities(),
+                world.densities(),
+            );
+            let vtk = |encoding, path: &Path| write_vtk_encoded(path, encoding, time, &x, &v, &rho);
+            match format {
+                FrameFormat::Vtk => vtk(VtkEncoding::Binary, &dir.join(format!("{name}.vtk"))),
+                FrameFormat::VtkAscii => vtk(VtkEncoding::Ascii, &dir.join(format!("{name}.vtk"))),
+                FrameFormat::Ply => write_ply(&dir.join(format!("{name}.ply")), time, &x, &v, &rho),
+            }
             .map_err(|e| Failure::Runtime(e.to_string()))?;
         }
         if let Some((dir, renderer)) = &self.pictures {

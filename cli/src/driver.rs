@@ -99,8 +99,8 @@ pub struct Runner {
 enum NextStep {
     /// The CFL-limited size (s).
     Cfl(f64),
-    /// Ending exactly at this time (s), a step of the size given second (s).
-    Until(f64, f64),
+    /// Ending exactly at this time (s).
+    Until(f64),
 }
 
 impl NextStep {
@@ -108,7 +108,7 @@ impl NextStep {
     fn land(world: &World, end: f64) -> Self {
         let dt = world.next_dt();
         if world.time() + dt >= end {
-            NextStep::Until(end, end - world.time())
+            NextStep::Until(end)
         } else {
             NextStep::Cfl(dt)
         }
@@ -181,14 +181,15 @@ impl Runner {
             None => (now * fps).ceil() as u64,
         };
         let frame = next as f64 / fps;
-        Some(match step {
-            // A step ending within the frame tolerance before the frame lands on it too.
-            NextStep::Cfl(dt) | NextStep::Until(_, dt)
-                if now + dt > frame - FRAME_TOLERANCE / fps =>
-            {
-                NextStep::Until(frame, frame - now)
-            }
-            step => step,
+        let end = match step {
+            NextStep::Cfl(dt) => now + dt,
+            NextStep::Until(end) => end,
+        };
+        // A step ending within the frame tolerance before the frame lands on it too.
+        Some(if end > frame - FRAME_TOLERANCE / fps {
+            NextStep::Until(frame)
+        } else {
+            step
         })
     }
 
@@ -201,7 +202,7 @@ impl Runner {
         let (clock, cpu) = (Instant::now(), process_cpu_seconds());
         let stats = match next {
             NextStep::Cfl(dt) => world.step_with_dt(dt)?,
-            NextStep::Until(end, _) => world.step_until(end)?,
+            NextStep::Until(end) => world.step_until(end)?,
         }
         .clone();
         let wall_seconds = clock.elapsed().as_secs_f64();

@@ -226,6 +226,19 @@ fn short_run_writes_stats_and_frames() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// Runs the binary with `args`, asserts it succeeded, and returns the JSON of the
+/// `--stats` file `stats` it wrote.
+fn run_ok_with_stats(args: &[&str], stats: &Path) -> serde_json::Value {
+    let out = projfluid(args);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&std::fs::read_to_string(stats).unwrap()).unwrap()
+}
+
 /// The TIME field of a binary VTK frame written by `projfluid run` (s).
 fn vtk_time(path: &Path) -> f64 {
     let bytes = std::fs::read(path).unwrap();
@@ -258,23 +271,20 @@ fn frames_carry_their_simulated_times() {
     let dir = temp_dir("frame-times");
     let (frames, stats) = (dir.join("frames"), dir.join("stats.json"));
     let (frames_arg, stats_arg) = (frames.to_str().unwrap(), stats.to_str().unwrap());
-    let out = projfluid(&[
-        "run",
-        "dam_break_small",
-        "--duration",
-        "0.09",
-        "--fps",
-        "50",
-        "--out",
-        frames_arg,
-        "--stats",
-        stats_arg,
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let json = run_ok_with_stats(
+        &[
+            "run",
+            "dam_break_small",
+            "--duration",
+            "0.09",
+            "--fps",
+            "50",
+            "--out",
+            frames_arg,
+            "--stats",
+            stats_arg,
+        ],
+        &stats,
     );
     let (header, rows) = read_csv(&frames.join("frames.csv"));
     assert_eq!(header, ["frame", "step", "time"]);
@@ -290,38 +300,31 @@ fn frames_carry_their_simulated_times() {
         assert!(step > last_step, "steps rise: {rows:?}");
         last_step = step;
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert_eq!(json["sim_time"], 0.09);
     assert!(json["steps"].as_f64().unwrap() > last_step, "{json}");
 
     let ascii = dir.join("ascii");
-    let out = projfluid(&[
-        "run",
-        "dam_break_small",
-        "--steps",
-        "2",
-        "--every",
-        "2",
-        "--format",
-        "vtk-ascii",
-        "--out",
-        ascii.to_str().unwrap(),
-        "--stats",
-        stats_arg,
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let json = run_ok_with_stats(
+        &[
+            "run",
+            "dam_break_small",
+            "--steps",
+            "2",
+            "--every",
+            "2",
+            "--format",
+            "vtk-ascii",
+            "--out",
+            ascii.to_str().unwrap(),
+            "--stats",
+            stats_arg,
+        ],
+        &stats,
     );
     let text = std::fs::read_to_string(ascii.join("frame_00001.vtk")).unwrap();
     let lines: Vec<&str> = text.lines().collect();
     assert_eq!(lines[2], "ASCII");
     assert_eq!(lines[5], "TIME 1 1 double");
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert_eq!(
         lines[6].parse::<f64>().unwrap(),
         json["sim_time"].as_f64().unwrap()
@@ -330,29 +333,26 @@ fn frames_carry_their_simulated_times() {
 
     let ply = dir.join("ply");
     let checkpoints = dir.join("checkpoints");
-    let out = projfluid(&[
-        "run",
-        "dam_break_small",
-        "--steps",
-        "6",
-        "--every",
-        "2",
-        "--format",
-        "ply",
-        "--out",
-        ply.to_str().unwrap(),
-        "--checkpoint-every",
-        "4",
-        "--checkpoint-dir",
-        checkpoints.to_str().unwrap(),
-        "--stats",
-        stats_arg,
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let json = run_ok_with_stats(
+        &[
+            "run",
+            "dam_break_small",
+            "--steps",
+            "6",
+            "--every",
+            "2",
+            "--format",
+            "ply",
+            "--out",
+            ply.to_str().unwrap(),
+            "--checkpoint-every",
+            "4",
+            "--checkpoint-dir",
+            checkpoints.to_str().unwrap(),
+            "--stats",
+            stats_arg,
+        ],
+        &stats,
     );
     let (header, rows) = read_csv(&ply.join("frames.csv"));
     assert_eq!(rows.len(), 4);
@@ -361,8 +361,6 @@ fn frames_carry_their_simulated_times() {
         let time = number(&header, row, "time");
         assert_eq!(ply_time(&ply.join(format!("frame_{k:05}.ply"))), time);
     }
-    let json: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
     assert_eq!(
         number(&header, &rows[3], "time"),
         json["sim_time"].as_f64().unwrap()
@@ -370,22 +368,21 @@ fn frames_carry_their_simulated_times() {
     let full = std::fs::read_to_string(ply.join("frames.csv")).unwrap();
     // Resuming from step 4 keeps frames 0–2 and writes frame 3 (step 6) again, bit for bit.
     let checkpoint = checkpoints.join("checkpoint_000004.pfck");
-    let out = projfluid(&[
-        "run",
-        "--resume",
-        checkpoint.to_str().unwrap(),
-        "--every",
-        "2",
-        "--format",
-        "ply",
-        "--out",
-        ply.to_str().unwrap(),
-    ]);
-    assert_eq!(
-        out.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    run_ok_with_stats(
+        &[
+            "run",
+            "--resume",
+            checkpoint.to_str().unwrap(),
+            "--every",
+            "2",
+            "--format",
+            "ply",
+            "--out",
+            ply.to_str().unwrap(),
+            "--stats",
+            stats_arg,
+        ],
+        &stats,
     );
     assert_eq!(
         std::fs::read_to_string(ply.join("frames.csv")).unwrap(),

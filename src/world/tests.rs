@@ -1,10 +1,8 @@
 use super::*;
 use crate::boundary::Aabb;
 
-/// Velocities set in insertion order come back in insertion order after the particles
-/// were re-sorted by a step; bad input changes nothing.
-#[test]
-fn set_velocities_uses_insertion_order_and_rejects_bad_input() {
+/// Twelve particles in a half-metre box, at the default parameters.
+fn tiny_world() -> World {
     let mut world = World::new(Params::default()).unwrap();
     let container = Aabb {
         min: Vec3::zeros(),
@@ -14,6 +12,14 @@ fn set_velocities_uses_insertion_order_and_rejects_bad_input() {
     world
         .add_fluid_block(Vec3::repeat(0.1), [3, 2, 2], Vec3::zeros())
         .unwrap();
+    world
+}
+
+/// Velocities set in insertion order come back in insertion order after the particles
+/// were re-sorted by a step; bad input changes nothing.
+#[test]
+fn set_velocities_uses_insertion_order_and_rejects_bad_input() {
+    let mut world = tiny_world();
     world.step().unwrap();
     let wanted: Vec<Vec3> = (0..12).map(|i| Vec3::new(i as f64, 0.5, -1.0)).collect();
     world.set_velocities(&wanted).unwrap();
@@ -467,15 +473,7 @@ fn spray_hitting_a_wall_stays_nearly_incompressed() {
 /// changes nothing.
 #[test]
 fn step_until_lands_on_the_requested_time() {
-    let mut world = World::new(Params::default()).unwrap();
-    let container = Aabb {
-        min: Vec3::zeros(),
-        max: Vec3::repeat(0.5),
-    };
-    world.add_container(container, 1).unwrap();
-    world
-        .add_fluid_block(Vec3::repeat(0.1), [3, 2, 2], Vec3::zeros())
-        .unwrap();
+    let mut world = tiny_world();
     world.step_with_dt(0.0003).unwrap();
     world.step_with_dt(0.0003).unwrap();
     let end = 0.0017;

@@ -210,18 +210,20 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(
         names,
         [
-            "frame_00000.vtk",
-            "frame_00001.vtk",
-            "frame_00002.vtk",
-            "frame_00003.vtk",
-            "frames.csv"
+            "frame_00000.vtp",
+            "frame_00001.vtp",
+            "frame_00002.vtp",
+            "frame_00003.vtp",
+            "frames.csv",
+            "frames.pvd"
         ]
     );
-    let last = std::fs::read(frames.join("frame_00003.vtk")).unwrap();
-    assert!(last.starts_with(b"# vtk DataFile Version 3.0\n"));
+    // VTK XML frames are the default.
+    let last = std::fs::read_to_string(frames.join("frame_00003.vtp")).unwrap();
+    assert!(last.starts_with("<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\""));
     assert!(
-        last.windows(b"POINTS 3840 float".len())
-            .any(|w| w == b"POINTS 3840 float")
+        last.contains("<Piece NumberOfPoints=\"3840\""),
+        "{last:.400}"
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
@@ -279,6 +281,8 @@ fn frames_carry_their_simulated_times() {
             "0.09",
             "--fps",
             "50",
+            "--format",
+            "vtk",
             "--out",
             frames_arg,
             "--stats",
@@ -388,6 +392,136 @@ fn frames_carry_their_simulated_times() {
         std::fs::read_to_string(ply.join("frames.csv")).unwrap(),
         full
     );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The TIME field of a VTK XML frame written by `projfluid run` (s): one Float64 in an
+/// inline base64 array, after its UInt64 byte count.
+fn vtp_time(path: &Path) -> f64 {
+    use base64::Engine;
+    let text = std::fs::read_to_string(path).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    let array = doc
+        .descendants()
+        .find(|n| n.has_tag_name("DataArray") && n.attribute("Name") == Some("TIME"))
+        .expect("TIME");
+    assert_eq!(array.parent().unwrap().tag_name().name(), "FieldData");
+    let base64 = array.text().unwrap().trim();
+    let bytes = base64::engine::general_purpose::STANDARD
+        .decode(base64)
+        .unwrap();
+    assert_eq!(bytes.len(), 16, "{base64}");
+    assert_eq!(u64::from_le_bytes(bytes[..8].try_into().unwrap()), 8);
+    f64::from_le_bytes(bytes[8..].try_into().unwrap())
+}
+
+/// The `(timestep, file)` of every data set a `.pvd` collection lists.
+fn read_pvd(path: &Path) -> Vec<(f64, String)> {
+    let text = std::fs::read_to_string(path).unwrap();
+    let doc = roxmltree::Document::parse(&text).unwrap();
+    assert_eq!(doc.root_element().attribute("type"), Some("Collection"));
+    doc.descendants()
+        .filter(|n| n.has_tag_name("DataSet"))
+        .map(|n| {
+            let time = n.attribute("timestep").unwrap().parse().unwrap();
+            (time, n.attribute("file").unwrap().to_string())
+        })
+        .collect()
+}
+
+/// Every file in `dir` with its bytes, by name.
+fn files_in(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut files: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| {
+            let e = e.unwrap();
+            let name = e.file_name().to_string_lossy().into_owned();
+            (name, std::fs::read(e.path()).unwrap())
+        })
+        .collect();
+    files.sort();
+    files
+}
+
+/// With VTK XML frames `frames.pvd` lists every frame file there is, at the time that
+/// `frames.csv` and the frame's own TIME field give. A run interrupted after a later frame
+/// and resumed from an earlier checkpoint writes the frames after the checkpoint again and
+/// continues index and collection, ending with the files of the uninterrupted run.
+#[test]
+fn pvd_lists_every_frame_at_its_time_and_resumes() {
+    let dir = temp_dir("pvd");
+    let (frames, checkpoints) = (dir.join("frames"), dir.join("checkpoints"));
+    let stats = dir.join("stats.json");
+    let output = [
+        "--fps",
+        "50",
+        "--format",
+        "vtp",
+        "--out",
+        frames.to_str().unwrap(),
+        "--stats",
+        stats.to_str().unwrap(),
+    ];
+    let mut args = vec!["run", "dam_break_small", "--duration", "0.09"];
+    args.extend(output);
+    args.extend(["--checkpoint-every", "4", "--checkpoint-dir"]);
+    args.push(checkpoints.to_str().unwrap());
+    let json = run_ok_with_stats(&args, &stats);
+    assert_eq!(json["sim_time"], 0.09);
+
+    let (header, rows) = read_csv(&frames.join("frames.csv"));
+    let datasets = read_pvd(&frames.join("frames.pvd"));
+    // Frames at 0, 0.02, …, 0.08.
+    assert_eq!(rows.len(), 5);
+    let listed: Vec<&str> = datasets.iter().map(|(_, f)| f.as_str()).collect();
+    let full = files_in(&frames);
+    let written: Vec<&str> = full
+        .iter()
+        .map(|(name, _)| name.as_str())
+        .filter(|name| name.ends_with(".vtp"))
+        .collect();
+    assert_eq!(listed, written);
+    for (k, (row, (time, file))) in rows.iter().zip(&datasets).enumerate() {
+        assert_eq!(*file, format!("frame_{k:05}.vtp"));
+        assert_eq!(*time, number(&header, row, "time"), "frame {k}");
+        assert_eq!(*time, k as f64 / 50.0, "frame {k}");
+        assert_eq!(vtp_time(&frames.join(file)), *time, "frame {k}");
+    }
+
+    // The state of the run stopped just after writing frame 3: no frame 4, and index and
+    // collection ending at frame 3.
+    let step = |k: usize| number(&header, &rows[k], "step") as u64;
+    std::fs::remove_file(frames.join("frame_00004.vtp")).unwrap();
+    let csv = std::fs::read_to_string(frames.join("frames.csv")).unwrap();
+    let csv: Vec<&str> = csv.lines().take(1 + 4).collect();
+    std::fs::write(frames.join("frames.csv"), csv.join("\n") + "\n").unwrap();
+    let pvd = std::fs::read_to_string(frames.join("frames.pvd")).unwrap();
+    let pvd: Vec<&str> = pvd
+        .lines()
+        .filter(|l| !l.contains("frame_00004.vtp"))
+        .collect();
+    std::fs::write(frames.join("frames.pvd"), pvd.join("\n") + "\n").unwrap();
+    assert_eq!(read_pvd(&frames.join("frames.pvd")).len(), 4);
+    // Resumed from the first checkpoint after frame 1, before frame 2: frames 2 and 3 are
+    // written again and frame 4 is new.
+    let saved = (step(1) + 1..step(2))
+        .map(|s| checkpoints.join(format!("checkpoint_{s:06}.pfck")))
+        .find(|path| path.exists())
+        .expect("a checkpoint between frames 1 and 2");
+    let mut args = vec!["run", "--resume", saved.to_str().unwrap()];
+    args.extend(output);
+    run_ok_with_stats(&args, &stats);
+    let resumed = files_in(&frames);
+    let names = |files: &[(String, Vec<u8>)]| -> Vec<String> {
+        files.iter().map(|(name, _)| name.clone()).collect()
+    };
+    assert_eq!(names(&resumed), names(&full));
+    for ((name, bytes), (_, expected)) in resumed.iter().zip(&full) {
+        assert!(
+            bytes == expected,
+            "{name} differs from the uninterrupted run's"
+        );
+    }
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

@@ -1,16 +1,21 @@
-//! Numbered outputs of a run: data frames (VTK or PLY) and PNG pictures, written at the
-//! start and then every N steps or at every multiple of 1/fps seconds, each carrying its
-//! simulated time; beside them `frames.csv` lists every frame's number, step and time.
+//! Numbered outputs of a run: data frames (VTK XML, legacy VTK or PLY) and PNG pictures,
+//! written at the start and then every N steps or at every multiple of 1/fps seconds, each
+//! carrying its simulated time; beside them `frames.csv` lists every frame's number, step and
+//! time, and with VTK XML frames `frames.pvd` lists the frames at their times for ParaView.
 
 use crate::Failure;
 use projfluid::World;
-use projfluid::io::{VtkEncoding, write_ply, write_vtk_encoded};
+use projfluid::io::{
+    PvdDataSet, VtkEncoding, write_atomically, write_ply, write_pvd, write_vtk_encoded, write_vtp,
+};
 use projfluid_lab::render::Renderer;
 use std::path::{Path, PathBuf};
 
 /// File format of the data frames.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
 pub(crate) enum FrameFormat {
+    /// VTK XML polydata with a frames.pvd time series (ParaView, VisIt).
+    Vtp,
     /// Legacy VTK polydata (ParaView, VisIt).
     Vtk,
     /// Legacy VTK polydata as text (larger; readable by any tool).
@@ -21,6 +26,30 @@ pub(crate) enum FrameFormat {
 
 /// The name of the index written beside the frames.
 const INDEX: &str = "frames.csv";
+
+/// The name of the collection written beside VTK XML frames.
+const COLLECTION: &str = "frames.pvd";
+
+impl FrameFormat {
+    /// The extension of its files.
+    fn extension(self) -> &'static str {
+        match self {
+            FrameFormat::Vtp => "vtp",
+            FrameFormat::Vtk | FrameFormat::VtkAscii => "vtk",
+            FrameFormat::Ply => "ply",
+        }
+    }
+}
+
+/// The name of frame `frame`'s files, without extension.
+fn frame_name(frame: usize) -> String {
+    format!("frame_{frame:05}")
+}
+
+/// The name of frame `frame`'s VTK XML file.
+fn vtp_file(frame: usize) -> String {
+    format!("{}.{}", frame_name(frame), FrameFormat::Vtp.extension())
+}
 
 /// One written frame: its number, the world's step count and its simulated time (s).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -36,6 +65,9 @@ pub(crate) struct Frames {
     pictures: Option<(PathBuf, Renderer)>,
     written: usize,
     index: Vec<Entry>,
+    /// The frames that `frames.pvd` lists: with VTK XML frames, those of `index` whose file
+    /// exists (a resumed run may continue one whose frames had another format).
+    collection: Vec<Entry>,
 }
 
 /// Creates `dir` if needed.
@@ -69,12 +101,14 @@ impl Frames {
             },
             written: 0,
             index: Vec::new(),
+            collection: Vec::new(),
         })
     }
 
     /// Numbers the next frame `index + 1`, as when frames 0..=index were written by an
     /// earlier run that this one continues; the earlier run's index rows up to that frame
-    /// are kept.
+    /// are kept, and so are the collection's entries of those frames whose VTK XML file
+    /// is there.
     pub(crate) fn continue_after(&mut self, index: u64) -> Result<(), Failure> {
         self.written = index as usize + 1;
         let dir = self.dirs().next().map(Path::to_path_buf);
@@ -83,6 +117,10 @@ impl Frames {
                 .into_iter()
                 .filter(|e| e.frame < self.written)
                 .collect();
+        }
+        if let Some((dir, FrameFormat::Vtp)) = &self.data {
+            let exists = |e: &&Entry| dir.join(vtp_file(e.frame)).is_file();
+            self.collection = self.index.iter().filter(exists).copied().collect();
         }
         Ok(())
     }
@@ -96,7 +134,7 @@ impl Frames {
 
     /// Writes the world's current state as the next frame.
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
-        let name = format!("frame_{:05}", self.written);
+        let name = frame_name(self.written);
         if let Some((dir, format)) = &self.data {
             let (time, x, v, rho) = (
                 world.time(),
@@ -104,11 +142,16 @@ impl Frames {
                 world.velocities(),
                 world.densities(),
             );
-            let vtk = |encoding, path: &Path| write_vtk_encoded(path, encoding, time, &x, &v, &rho);
+            let path = dir.join(format!("{name}.{}", format.extension()));
             match format {
-                FrameFormat::Vtk => vtk(VtkEncoding::Binary, &dir.join(format!("{name}.vtk"))),
-                FrameFormat::VtkAscii => vtk(VtkEncoding::Ascii, &dir.join(format!("{name}.vtk"))),
-                FrameFormat::Ply => write_ply(&dir.join(format!("{name}.ply")), time, &x, &v, &rho),
+                FrameFormat::Vtp => write_vtp(&path, time, &x, &v, &rho),
+                FrameFormat::Vtk => {
+                    write_vtk_encoded(&path, VtkEncoding::Binary, time, &x, &v, &rho)
+                }
+                FrameFormat::VtkAscii => {
+                    write_vtk_encoded(&path, VtkEncoding::Ascii, time, &x, &v, &rho)
+                }
+                FrameFormat::Ply => write_ply(&path, time, &x, &v, &rho),
             }
             .map_err(|e| Failure::Runtime(e.to_string()))?;
         }
@@ -118,20 +161,36 @@ impl Frames {
                 .write_png(&dir.join(format!("{name}.png")))
                 .map_err(|e| Failure::Runtime(e.to_string()))?;
         }
-        self.index.push(Entry {
+        let entry = Entry {
             frame: self.written,
             step: world.steps(),
             time: world.time(),
-        });
+        };
+        self.index.push(entry);
+        // Index and collection are replaced whole, so that a run stopped at any point
+        // leaves them readable, and a resumed run can continue them.
         let text = index_text(&self.index);
+        let runtime = |e: projfluid::Error| Failure::Runtime(e.to_string());
         for dir in self.dirs() {
-            let path = dir.join(INDEX);
-            std::fs::write(&path, &text)
-                .map_err(|e| Failure::Runtime(format!("cannot write {}: {e}", path.display())))?;
+            write_atomically(&dir.join(INDEX), text.as_bytes()).map_err(runtime)?;
+        }
+        if let Some((dir, FrameFormat::Vtp)) = &self.data {
+            self.collection.push(entry);
+            write_pvd(&dir.join(COLLECTION), &collection(&self.collection)).map_err(runtime)?;
         }
         self.written += 1;
         Ok(())
     }
+}
+
+/// The collection's entries for VTK XML `frames`: each frame's file, beside the
+/// collection, at its simulated time.
+fn collection(frames: &[Entry]) -> Vec<PvdDataSet> {
+    let dataset = |e: &Entry| PvdDataSet {
+        time: e.time,
+        file: vtp_file(e.frame),
+    };
+    frames.iter().map(dataset).collect()
 }
 
 /// The index file's text: a header line, then `frame,step,time` per frame, the time (s)

@@ -56,11 +56,13 @@ pub(crate) struct RunArgs {
     solver: Option<SolverKind>,
     #[command(flatten)]
     params: ParamOptions,
-    /// Write data frames (frame_00000.vtk or .ply, …) into this directory, created if missing.
+    /// Write data frames (frame_00000.vtp, .vtk or .ply, …) into this directory, created if
+    /// missing.
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
-    /// File format of the data frames: VTK (ParaView) or binary PLY (Blender, MeshLab).
-    #[arg(long, value_enum, default_value_t = FrameFormat::Vtk)]
+    /// File format of the data frames: VTK XML with a frames.pvd time series (ParaView,
+    /// VisIt), legacy VTK, or binary PLY (Blender, MeshLab).
+    #[arg(long, value_enum, default_value_t = FrameFormat::Vtp)]
     format: FrameFormat,
     /// Write PNG pictures (frame_00000.png, …) into this directory, created if missing.
     #[arg(long, value_name = "DIR")]

@@ -177,8 +177,8 @@ fn small_tank(threads: usize) -> World {
 }
 
 /// The ends of a gauge and the undefined readings: a dry bottom reads 0, a column over the
-/// top reads top − bottom; a probe in the air reads NaN, one on a dry wall 0, one on no wall
-/// NaN.
+/// top reads top − bottom, a dry floor less than a spacing; a probe in the air reads NaN, one
+/// on a dry wall 0, one on no wall NaN.
 #[test]
 fn gauge_ends_and_undefined_pressures() {
     let world = small_tank(1);
@@ -193,6 +193,7 @@ fn gauge_ends_and_undefined_pressures() {
             gauge("floor", None, None),
             gauge("dry", Some(0.3), None),
             gauge("short", Some(0.05), Some(0.1)),
+            Gauge::new("dry_floor", 0.42, 0.42),
         ],
         pressure: vec![
             PressureProbe::new("air", [0.25, 0.45, 0.25]),
@@ -204,7 +205,10 @@ fn gauge_ends_and_undefined_pressures() {
     // The lattice's top centres are at 0.2 m, its top face at 0.225 m.
     let h = reading.heights[0];
     assert!((0.175..=0.25).contains(&h), "{h}");
-    assert_eq!(&reading.heights[1..], &[0.0, 0.1 - 0.05]);
+    assert_eq!(&reading.heights[1..3], &[0.0, 0.1 - 0.05]);
+    // A dry floor reads where the wall's own fraction falls to ½, within a spacing of it.
+    let dry = reading.heights[3];
+    assert!(dry > 0.0 && dry < world.params().spacing(), "{dry}");
     assert!(reading.pressures[0].is_nan());
     assert_eq!(reading.pressures[1], 0.0);
     assert!(reading.pressures[2].is_nan());
@@ -404,4 +408,27 @@ fn scene_key_probes_reads_and_round_trips() {
             .to_string(),
         "probes must hold at least one gauge or pressure probe, got no probes"
     );
+}
+
+/// The example of docs/scene-format.md reads in `dam_break_30k`, and its wall probe lies on
+/// the far wall's particles.
+#[test]
+fn documented_probes_example_is_valid() {
+    let doc = include_str!("../../docs/scene-format.md");
+    let example = doc
+        .split("```json\n")
+        .find(|block| block.starts_with("\"probes\""))
+        .and_then(|rest| rest.split("```").next())
+        .expect("docs/scene-format.md has a probes example");
+    let scene = Scene::builtin("dam_break_30k").unwrap().to_json();
+    let text = format!(
+        "{{{example}, {}",
+        scene.trim_start().trim_start_matches('{')
+    );
+    let scene = Scene::from_json(&text).unwrap();
+    let probes = scene.probes.unwrap();
+    assert_eq!(probes.columns(), ["H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(probes.rate, 100.0);
+    assert!(probes.pressure[1].wall);
+    assert_eq!(probes.pressure[1].position[0], scene.containers[0].max[0]);
 }

@@ -52,14 +52,7 @@ impl World {
         let (mut fluid_lists, mut boundary_lists) =
             (NeighborLists::default(), NeighborLists::default());
         grid.search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists);
-        grid.search(
-            &snapshot.boundary_table,
-            bx,
-            x,
-            h,
-            false,
-            &mut boundary_lists,
-        );
+        snapshot.boundary_near(x, h, &mut boundary_lists);
         let c = &self.constraint;
         let mut weights = Vec::new();
         c.weights(&fluid_lists, &mut weights);

@@ -183,16 +183,8 @@ fn fraction(
     let (kernel, h) = (&c.kernel, world.params().support_radius());
     let volume = c.mass / c.rest_density;
     let s = snapshot;
-    s.grid
-        .search(&s.fluid_table, &s.fluid, points, h, false, fluid_lists);
-    s.grid.search(
-        &s.boundary_table,
-        &s.boundary,
-        points,
-        h,
-        false,
-        boundary_lists,
-    );
+    s.fluid_near(points, h, fluid_lists);
+    s.boundary_near(points, h, boundary_lists);
     points
         .iter()
         .enumerate()

@@ -116,8 +116,7 @@ impl Field<'_> {
     fn interpolated(&self, x: Vec3, lists: &mut NeighborLists) -> f64 {
         let (s, kernel) = (self.snapshot, &self.world.constraint.kernel);
         let h = kernel.support_radius();
-        s.grid
-            .search(&s.fluid_table, &s.fluid, &[x], h, false, lists);
+        s.fluid_near(&[x], h, lists);
         let (weighted, total) = lists
             .of(0)
             .iter()
@@ -142,15 +141,13 @@ impl Field<'_> {
     fn wall_stress(&self, x: Vec3, (fluid, boundary): &mut (NeighborLists, NeighborLists)) -> f64 {
         let (s, c) = (self.snapshot, &self.world.constraint);
         let h = c.kernel.support_radius();
-        s.grid
-            .search(&s.boundary_table, &s.boundary, &[x], h, false, boundary);
+        s.boundary_near(&[x], h, boundary);
         let near: Vec<u32> = boundary.of(0).to_vec();
         if near.is_empty() {
             return f64::NAN;
         }
         let at: Vec<Vec3> = near.iter().map(|&b| s.boundary[b as usize]).collect();
-        s.grid
-            .search(&s.fluid_table, &s.fluid, &at, h, false, fluid);
+        s.fluid_near(&at, h, fluid);
         let volume = c.mass / c.rest_density;
         let stress: Vec3 = near
             .iter()

@@ -5,7 +5,7 @@
 use super::World;
 use crate::Vec3;
 use crate::boundary::{Aabb, akinci_volumes};
-use crate::neighbors::{CellTable, PointsByComponent, UniformGrid};
+use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 
 /// Fluid and boundary particles sorted into one grid of cell size H, the boundary with its
 /// Akinci masses.
@@ -16,12 +16,32 @@ pub(crate) struct Snapshot {
     pub fluid_table: CellTable,
     /// Fluid positions (m), in the order of `fluid_table`.
     pub fluid: Vec<Vec3>,
+    /// `fluid` by component, for searches among them.
+    pub fluid_components: PointsByComponent,
     /// Where each cell's boundary particles lie in `boundary`.
     pub boundary_table: CellTable,
     /// Boundary positions (m), in the order of `boundary_table`.
     pub boundary: Vec<Vec3>,
+    /// `boundary` by component, for searches among them.
+    pub boundary_components: PointsByComponent,
     /// Akinci mass ψ_b = ρ0·V_b (kg) of each of `boundary` (docs/method.md §2.6).
     pub psi: Vec<f64>,
+}
+
+impl Snapshot {
+    /// For every query point, the fluid particles within the support radius `h` (m), as
+    /// indices into `fluid`, ascending.
+    pub fn fluid_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
+        let (table, points) = (&self.fluid_table, &self.fluid_components);
+        self.grid.search_in(table, points, queries, h, false, out);
+    }
+
+    /// For every query point, the boundary particles within the support radius `h` (m), as
+    /// indices into `boundary`, ascending.
+    pub fn boundary_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
+        let (table, points) = (&self.boundary_table, &self.boundary_components);
+        self.grid.search_in(table, points, queries, h, false, out);
+    }
 }
 
 impl World {
@@ -46,21 +66,23 @@ impl World {
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
         let fluid_order = sorted(fluid, &mut fluid_table);
         let boundary_order = sorted(&boundary.positions, &mut boundary_table);
-        let fluid = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
+        let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
         let bx: Vec<Vec3> = boundary_order
             .iter()
             .map(|&i| boundary.positions[i as usize])
             .collect();
+        let (mut fluid_components, mut boundary_components) =
+            (PointsByComponent::default(), PointsByComponent::default());
+        fluid_components.fill(&fluid);
+        boundary_components.fill(&bx);
         let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
             boundary_order
                 .iter()
                 .map(|&i| boundary.psi[i as usize])
                 .collect()
         } else {
-            let mut by_component = PointsByComponent::default();
-            by_component.fill(&bx);
             let kernel = &self.constraint.kernel;
-            akinci_volumes(&grid, &boundary_table, &bx, &by_component, kernel)
+            akinci_volumes(&grid, &boundary_table, &bx, &boundary_components, kernel)
                 .into_iter()
                 .map(|v| v * self.params.rest_density)
                 .collect()
@@ -69,8 +91,10 @@ impl World {
             grid,
             fluid_table,
             fluid,
+            fluid_components,
             boundary_table,
             boundary: bx,
+            boundary_components,
             psi,
         })
     }

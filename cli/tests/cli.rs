@@ -955,13 +955,16 @@ fn probes_write_a_csv_at_their_rate_and_resume() {
         args.push(out.to_str().unwrap());
         args.extend(extra);
         let out = projfluid(&args);
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{stderr}");
+        stderr
     };
-    run(&whole, &[]);
+    // At the default settings the pressure readings are not to be trusted, and the run says
+    // so; solved tightly it does not.
+    let warning = "warning: the pressure probes read the constraint forces";
+    assert!(run(&whole, &[]).contains(warning));
+    let tight = dir.join("tight");
+    assert!(!run(&tight, &["--tau", "2.5e-7", "--eta", "0", "--steps", "1"]).contains(warning));
     let (header, rows) = read_csv(&whole.join("probes.csv"));
     assert_eq!(header, ["time_s", "H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
     assert_eq!(rows.len(), 11, "{rows:?}");

@@ -43,6 +43,7 @@ fn main() -> Result<(), projfluid::Error> {
         domain: None,
         duration: 0.3,
         output: OutputSpec::default(),
+        probes: None,
     };
     // Checks every key as a scene file's would be checked: errors name the field and value.
     scene.validate()?;

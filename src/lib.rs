@@ -28,6 +28,7 @@ pub mod kernel;
 pub mod neighbors;
 pub mod params;
 pub mod pressure;
+pub mod probe;
 mod random;
 pub mod reduce;
 mod reserve;

@@ -10,16 +10,16 @@
 //! It is a reading of the constraint forces (their magnitude is set by the force balance, not
 //! by an equation of state), and as such needs a tight outer tolerance to be accurate.
 
-use crate::boundary::Aabb;
 use crate::constraint::{Corrections, Neighborhood, Projection};
-use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
+use crate::neighbors::NeighborLists;
+use crate::world::Snapshot;
 use crate::{Vec3, World};
 
 /// Pressures estimated from the constraint forces at the current positions.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct ConstraintPressures {
-    /// Every fluid particle's position (m) and pressure estimate (Pa), in the world's storage
-    /// order.
+    /// Every fluid particle's position (m) and pressure estimate (Pa), in the order of a
+    /// neighbour grid's cells.
     pub samples: Vec<(Vec3, f64)>,
     /// The mean vertical (y) constraint force per fluid particle (N): in a tank at rest it
     /// balances the particle's weight.
@@ -28,80 +28,58 @@ pub struct ConstraintPressures {
 
 impl World {
     /// The pressure estimate p_i = −k·λ_i·w_i/V (Pa) of every fluid particle at its current
-    /// position (see the module docs), with that position, in storage order; and the mean
-    /// vertical constraint force per particle (N).
+    /// position (see the module docs), with that position; and the mean vertical constraint
+    /// force per particle (N).
     pub fn constraint_pressures(&self) -> ConstraintPressures {
-        let world = self;
-        let params = &world.params;
-        let h = params.support_radius();
-        let fluid = &world.fluid.positions;
-        let boundary = &world.boundary;
-        let bounds = [fluid.as_slice(), &boundary.positions]
-            .iter()
-            .filter_map(|p| Aabb::around(p))
-            .reduce(|a, b| a.union(&b));
-        let Some(bounds) = bounds else {
-            return ConstraintPressures::default();
-        };
-        world.pool.install(|| {
-            let grid = UniformGrid::covering(bounds.min, bounds.max, h);
-            let sorted = |points: &[Vec3], table: &mut CellTable| {
-                let mut order = Vec::new();
-                grid.sort(points, &mut order, table);
-                order
+        self.pool.install(|| {
+            let Some(snapshot) = self.snapshot() else {
+                return ConstraintPressures::default();
             };
-            let (mut fluid_table, mut boundary_table) =
-                (CellTable::default(), CellTable::default());
-            let fluid_order = sorted(fluid, &mut fluid_table);
-            let boundary_order = sorted(&boundary.positions, &mut boundary_table);
-            let x: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
-            let bx: Vec<Vec3> = boundary_order
-                .iter()
-                .map(|&i| boundary.positions[i as usize])
-                .collect();
-            let psi: Vec<f64> = boundary_order
-                .iter()
-                .map(|&i| boundary.psi[i as usize])
-                .collect();
-            let (mut fluid_lists, mut boundary_lists) =
-                (NeighborLists::default(), NeighborLists::default());
-            grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
-            grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
-            let mut weights = Vec::new();
-            world.constraint.weights(&fluid_lists, &mut weights);
-            let nb = Neighborhood {
-                fluid: &fluid_lists,
-                boundary: &boundary_lists,
-                boundary_positions: &bx,
-                boundary_psi: &psi,
-                weights: &weights,
-            };
-            let (mut projections, mut corrections) =
-                (Vec::<Projection>::new(), Corrections::default());
-            world
-                .constraint
-                .project(&x, &nb, &mut projections, &mut corrections);
-            let volume = world.constraint.mass / world.constraint.rest_density;
-            // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
-            // step gathers it.
-            let c = &world.constraint;
-            let mut gathered = vec![Vec3::zeros(); x.len()];
-            c.gathered_corrections(0, &x, &nb, &projections, &corrections, &mut gathered);
-            let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
-            let support = force_sum * params.stiffness / x.len().max(1) as f64;
-            let pressures = x
-                .iter()
-                .zip(&projections)
-                .enumerate()
-                .map(|(i, (p, proj))| {
-                    let weight = c.membership(&fluid_lists, i);
-                    (*p, -params.stiffness * proj.lambda * weight / volume)
-                })
-                .collect();
+            let (pressures, mean_vertical_force) = self.pressure_field(&snapshot);
             ConstraintPressures {
-                samples: pressures,
-                mean_vertical_force: support,
+                samples: snapshot.fluid.iter().copied().zip(pressures).collect(),
+                mean_vertical_force,
             }
         })
+    }
+
+    /// The pressure estimate (Pa) of every fluid particle of `snapshot`, in its order, and the
+    /// mean vertical constraint force per particle (N). Runs on the caller's thread pool.
+    pub(crate) fn pressure_field(&self, snapshot: &Snapshot) -> (Vec<f64>, f64) {
+        let params = &self.params;
+        let h = params.support_radius();
+        let (grid, x, bx) = (&snapshot.grid, &snapshot.fluid, &snapshot.boundary);
+        let (mut fluid_lists, mut boundary_lists) =
+            (NeighborLists::default(), NeighborLists::default());
+        grid.search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists);
+        snapshot.boundary_near(x, h, &mut boundary_lists);
+        let c = &self.constraint;
+        let mut weights = Vec::new();
+        c.weights(&fluid_lists, &mut weights);
+        let nb = Neighborhood {
+            fluid: &fluid_lists,
+            boundary: &boundary_lists,
+            boundary_positions: bx,
+            boundary_psi: &snapshot.psi,
+            weights: &weights,
+        };
+        let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
+        c.project(x, &nb, &mut projections, &mut corrections);
+        let volume = c.mass / c.rest_density;
+        // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
+        // step gathers it.
+        let mut gathered = vec![Vec3::zeros(); x.len()];
+        c.gathered_corrections(0, x, &nb, &projections, &corrections, &mut gathered);
+        let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
+        let support = force_sum * params.stiffness / x.len().max(1) as f64;
+        let pressures = projections
+            .iter()
+            .enumerate()
+            .map(|(i, proj)| {
+                let weight = c.membership(&fluid_lists, i);
+                -params.stiffness * proj.lambda * weight / volume
+            })
+            .collect();
+        (pressures, support)
     }
 }

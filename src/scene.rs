@@ -1,5 +1,5 @@
 //! Scenes: a fluid setup (parameters, container boxes, obstacles, rigid bodies, blocks of
-//! fluid, duration, output) read from JSON (format in docs/scene-format.md) or taken from the
+//! fluid, duration, output, probes) read from JSON (format in docs/scene-format.md) or taken from the
 //! built-in list.
 //!
 //! ```
@@ -26,6 +26,7 @@ pub use spec::{
 
 use crate::boundary::Aabb;
 use crate::params::Params;
+use crate::probe::ProbeSet;
 use crate::{EmitterSpec, Error, Vec3, World};
 use std::path::Path;
 
@@ -57,6 +58,8 @@ pub struct Scene {
     pub duration: f64,
     /// Frame output settings.
     pub output: OutputSpec,
+    /// Water-height gauges and pressure probes read at a set rate (`None`: no probes).
+    pub probes: Option<ProbeSet>,
 }
 
 impl Scene {
@@ -124,7 +127,7 @@ impl Scene {
     /// Checks the whole scene: parameters (named by their JSON keys, e.g. `solver.rho`),
     /// duration, output, containers, obstacles, bodies (e.g. `bodies[1].density`), fluid
     /// blocks (every particle centre inside a container), emitters (e.g. `emitters[0].speed`),
-    /// sinks and the domain.
+    /// sinks, the domain and the probes (e.g. `probes.gauges[0].bottom`).
     pub fn validate(&self) -> Result<(), Error> {
         validate::validate(self)
     }
@@ -190,6 +193,28 @@ impl Scene {
     pub fn to_json(&self) -> String {
         file::to_json(self)
     }
+}
+
+/// Parses and validates a `probes` object ([`ProbeSet`], the value of the scene key `probes`)
+/// from JSON text, on its own: the checks that need the scene (gravity along −y for gauges,
+/// a container floor under a gauge without a bottom, the rate against `time.dt_min`) come
+/// when a scene holding it is validated. Errors name the key (`probes.gauges[0].bottom`).
+pub fn probes_from_json(text: &str) -> Result<ProbeSet, Error> {
+    let probes = file::parse_probes(text, None)?;
+    probes.validate()?;
+    Ok(probes)
+}
+
+/// [`probes_from_json`] on the text of the file at `path`; every error message starts with
+/// the path.
+pub fn load_probes(path: &Path) -> Result<ProbeSet, Error> {
+    let text = std::fs::read_to_string(path)
+        .map_err(|e| Error::Io(format!("cannot read probes file {}: {e}", path.display())))?;
+    let probes = file::parse_probes(&text, Some(path))?;
+    probes
+        .validate()
+        .map_err(|e| prefixed(e, &format!("{}: ", path.display())))?;
+    Ok(probes)
 }
 
 /// Puts `prefix` in front of an error's message.

@@ -86,8 +86,8 @@ impl From<RunError<std::convert::Infallible>> for Error {
 /// energy.
 pub struct Runner {
     length: RunLength,
-    /// Frames per simulated second whose times the steps land on (1/s).
-    landing: Option<f64>,
+    /// Rates (1/s) whose multiples of 1/rate seconds the steps land on: frames, probe readings.
+    landing: Vec<f64>,
     datum: f64,
     start_time: f64,
     start_steps: u64,
@@ -145,7 +145,7 @@ impl Runner {
         acc.record_energy(total_energy(world, datum));
         Ok(Self {
             length,
-            landing: None,
+            landing: Vec::new(),
             datum,
             start_time: world.time(),
             start_steps: world.steps(),
@@ -154,9 +154,10 @@ impl Runner {
     }
 
     /// Lands the run's steps on every multiple of 1/`fps` seconds of simulated time: a step
-    /// that would pass one is shortened to end on it ([`frame_index`] tells which).
+    /// that would pass one is shortened to end on it ([`frame_index`] tells which). Called
+    /// again with another rate, the steps land on the times of both.
     pub fn landing_on(mut self, fps: f64) -> Self {
-        self.landing = Some(fps);
+        self.landing.push(fps);
         self
     }
 
@@ -173,24 +174,32 @@ impl Runner {
             RunLength::Duration(d) => until(self.start_time + d),
             RunLength::UntilTime(end) => until(end),
         }?;
-        let Some(fps) = self.landing else {
-            return Some(step);
-        };
-        let next = match frame_index(now, fps) {
-            Some(k) => k + 1,
-            None => (now * fps).ceil() as u64,
-        };
-        let frame = next as f64 / fps;
         let end = match step {
             NextStep::Cfl(dt) => now + dt,
             NextStep::Until(end) => end,
         };
-        // A step ending within the frame tolerance before the frame lands on it too.
-        Some(if end > frame - FRAME_TOLERANCE / fps {
-            NextStep::Until(frame)
-        } else {
-            step
-        })
+        // The next landing time of every rate, earliest first.
+        let mut ahead: Vec<(f64, f64)> = (self.landing.iter())
+            .map(|&fps| {
+                let next = match frame_index(now, fps) {
+                    Some(k) => k + 1,
+                    None => (now * fps).ceil() as u64,
+                };
+                (next as f64 / fps, fps)
+            })
+            .collect();
+        ahead.sort_by(|a, b| a.0.total_cmp(&b.0));
+        // The step lands on the first time it would pass; one ending within the frame
+        // tolerance before a time lands on it too.
+        Some(
+            match ahead
+                .iter()
+                .find(|&&(time, fps)| end > time - FRAME_TOLERANCE / fps)
+            {
+                Some(&(time, _)) => NextStep::Until(time),
+                None => step,
+            },
+        )
     }
 
     /// Takes the run's next step of `world` (the world it started with), or returns `None`
@@ -262,21 +271,21 @@ pub fn run<E>(
     length: RunLength,
     on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
 ) -> Result<RunAccumulator, RunError<E>> {
-    run_landing(world, length, None, on_step)
+    run_landing(world, length, &[], on_step)
 }
 
-/// [`run`], its steps landing on every multiple of 1/`fps` seconds where `fps` is given
-/// ([`Runner::landing_on`]).
+/// [`run`], its steps landing on every multiple of 1/rate seconds for each of `rates` (1/s;
+/// frames per second, probe readings per second; [`Runner::landing_on`]).
 pub fn run_landing<E>(
     world: &mut World,
     length: RunLength,
-    fps: Option<f64>,
+    rates: &[f64],
     mut on_step: impl FnMut(&StepReport<'_>) -> Result<(), E>,
 ) -> Result<RunAccumulator, RunError<E>> {
     let mut runner =
         Runner::new(world, length).map_err(|error| RunError::Step { step: 1, error })?;
-    if let Some(fps) = fps {
-        runner = runner.landing_on(fps);
+    for &rate in rates {
+        runner = runner.landing_on(rate);
     }
     loop {
         let taken = match runner.step(world) {
@@ -398,5 +407,26 @@ mod tests {
         assert_eq!(stopped.unwrap_err(), RunError::Callback("enough"));
         let bad = run_quietly(&mut world, RunLength::Duration(f64::NAN)).unwrap_err();
         assert!(bad.to_string().contains("duration"), "{bad}");
+    }
+
+    /// With two rates a step ends exactly on every multiple of either interval.
+    #[test]
+    fn steps_land_on_the_times_of_every_rate() {
+        let mut world = small_world();
+        let mut times = Vec::new();
+        run_landing(&mut world, RunLength::Duration(0.1), &[30.0, 100.0], |r| {
+            times.push(r.world.time());
+            Ok::<(), ()>(())
+        })
+        .unwrap();
+        let on = |rate: f64| {
+            (1..)
+                .map(move |k| k as f64 / rate)
+                .take_while(|&t| t <= 0.1)
+        };
+        for t in on(30.0).chain(on(100.0)) {
+            assert!(times.contains(&t), "no step ends at {t}: {times:?}");
+        }
+        assert_eq!(times.last(), Some(&0.1));
     }
 }

@@ -1054,3 +1054,131 @@ fn damaged_checkpoints_exit_2_with_a_clear_message() {
     assert_bad_input(&out, &["--checkpoint-every", "0"]);
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A small tank whose own `probes` (a gauge read at 50 Hz) the probes files replace.
+const PROBE_TANK: &str = r#"{
+  "particle_radius": 0.025,
+  "container": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.3]},
+  "fluid_blocks": [{"start": [0.05, 0.05, 0.05], "count": [6, 4, 4]}],
+  "duration": 0.05,
+  "probes": {"rate": 50, "gauges": [{"name": "S", "x": 0.2, "z": 0.15}]}
+}"#;
+
+/// Two gauges, a probe in the fluid and one on a side wall, read at 200 Hz.
+const PROBES: &str = r#"{
+  "rate": 200,
+  "gauges": [{"name": "H1", "x": 0.15, "z": 0.15}, {"name": "H2", "x": 0.25, "z": 0.15, "bottom": 0.0, "top": 0.35}],
+  "pressure": [{"name": "P1", "position": [0.2, 0.06, 0.15]},
+               {"name": "W1", "position": [0.0, 0.06, 0.15], "wall": true}]
+}"#;
+
+/// `--probes FILE` replaces the scene's probes and writes probes.csv beside the frames: a
+/// header with units, a row at every multiple of 1/200 s exactly (frames at 1/60 s as
+/// well), finite values; a resumed run continues the file to what an uninterrupted run
+/// writes, bit for bit.
+#[test]
+fn probes_write_a_csv_at_their_rate_and_resume() {
+    let dir = temp_dir("probes");
+    let (scene, probes) = (dir.join("tank.json"), dir.join("probes.json"));
+    std::fs::write(&scene, PROBE_TANK).unwrap();
+    std::fs::write(&probes, PROBES).unwrap();
+    let (whole, saved, ckpt) = (dir.join("whole"), dir.join("saved"), dir.join("ckpt"));
+    let run = |out: &Path, extra: &[&str]| {
+        let mut args = vec!["run", scene.to_str().unwrap(), "--probes"];
+        args.extend([probes.to_str().unwrap(), "--fps", "60", "--out"]);
+        args.push(out.to_str().unwrap());
+        args.extend(extra);
+        let out = projfluid(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(out.status.success(), "{stderr}");
+        stderr
+    };
+    // At the default settings the pressure readings are not to be trusted, and the run says
+    // so; solved tightly it does not.
+    let warning = "warning: the pressure probes read the constraint forces";
+    assert!(run(&whole, &[]).contains(warning));
+    let tight = dir.join("tight");
+    assert!(!run(&tight, &["--tau", "2.5e-7", "--eta", "0", "--steps", "1"]).contains(warning));
+    let (header, rows) = read_csv(&whole.join("probes.csv"));
+    assert_eq!(header, ["time_s", "H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(rows.len(), 11, "{rows:?}");
+    for (k, row) in rows.iter().enumerate() {
+        assert_eq!(number(&header, row, "time_s"), k as f64 / 200.0, "row {k}");
+        for column in &header[1..] {
+            let value = number(&header, row, column);
+            assert!(value.is_finite(), "{column} at row {k}: {value}");
+        }
+        for gauge in ["H1_m", "H2_m"] {
+            let h = number(&header, row, gauge);
+            assert!((0.1..=0.35).contains(&h), "{gauge} at row {k}: {h}");
+        }
+    }
+    let (frame_header, frames) = read_csv(&whole.join("frames.csv"));
+    for (k, row) in frames.iter().enumerate() {
+        assert_eq!(number(&frame_header, row, "time"), k as f64 / 60.0);
+    }
+    assert_eq!(frames.len(), 4);
+
+    run(
+        &saved,
+        &[
+            "--checkpoint-every",
+            "6",
+            "--checkpoint-dir",
+            ckpt.to_str().unwrap(),
+        ],
+    );
+    let checkpoint = ckpt.join("checkpoint_000006.pfck");
+    let out = projfluid(&["run", "--resume", checkpoint.to_str().unwrap()]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert_eq!(
+        std::fs::read_to_string(saved.join("probes.csv")).unwrap(),
+        std::fs::read_to_string(whole.join("probes.csv")).unwrap()
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// Bad probes exit 2 naming the file, the key and the value; so do probes without an output
+/// directory.
+#[test]
+fn bad_probes_exit_2() {
+    let dir = temp_dir("bad-probes");
+    let scene = dir.join("tank.json");
+    std::fs::write(&scene, PROBE_TANK).unwrap();
+    let out_dir = dir.join("out");
+    let run = |probes: &str, out: bool| {
+        let path = dir.join("probes.json");
+        std::fs::write(&path, probes).unwrap();
+        let mut args = vec!["run", scene.to_str().unwrap(), "--steps", "1", "--probes"];
+        args.push(path.to_str().unwrap());
+        if out {
+            args.extend(["--out", out_dir.to_str().unwrap()]);
+        }
+        projfluid(&args)
+    };
+    let duplicate = PROBES.replace("\"H2\"", "\"H1\"");
+    assert_bad_input(
+        &run(&duplicate, true),
+        &["probes.json: probes.gauges[1].name must be unique", "`H1`"],
+    );
+    let inverted = PROBES.replace("\"top\": 0.35", "\"top\": -0.1");
+    assert_bad_input(
+        &run(&inverted, true),
+        &["probes.gauges[1].bottom must lie below top (-0.1), got 0"],
+    );
+    assert_bad_input(
+        &run("{\"rate\": 200, \"gauges\": [}", true),
+        &["probes.json", "line 1", "invalid JSON"],
+    );
+    assert_bad_input(&run(PROBES, false), &["probes.csv", "--out"]);
+    let fast = PROBES.replace("\"rate\": 200", "\"rate\": 1e5");
+    assert_bad_input(
+        &run(&fast, true),
+        &["probes.rate must be at most 1/dt_min", "got 100000"],
+    );
+    std::fs::remove_dir_all(&dir).unwrap();
+}

@@ -225,6 +225,7 @@ fn dam_break(
         domain: None,
         duration,
         output: OutputSpec::default(),
+        probes: None,
     }
 }
 

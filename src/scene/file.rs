@@ -12,6 +12,7 @@ mod tests;
 use super::{BoxSpec, ContainerSpec, FluidBlock, OutputSpec, Scene};
 use crate::Error;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+use crate::probe::ProbeSet;
 use bodies::BodyFile;
 use error::json_error;
 use flow::EmitterFile;
@@ -53,6 +54,8 @@ struct SceneFile {
     threads: Option<usize>,
     duration: f64,
     output: Option<OutputFile>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    probes: Option<ProbeSet>,
 }
 
 /// `solver`: the global solver and the outer iteration.
@@ -164,6 +167,23 @@ impl<'de> Deserialize<'de> for Containers {
     }
 }
 
+/// Parses a `probes` object (the scene key's value, e.g. a file of its own) without
+/// validating values. `origin` (the file, if any) and the line and column start the message
+/// of a JSON error, whose key path starts with `probes`.
+pub(super) fn parse_probes(text: &str, origin: Option<&Path>) -> Result<ProbeSet, Error> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    serde_path_to_error::deserialize(&mut de)
+        .map_err(|e| {
+            let inner = e.path().to_string();
+            let path = match inner.as_str() {
+                "." => "probes".to_string(),
+                _ => format!("probes.{inner}"),
+            };
+            json_error(e.into_inner(), &path, origin)
+        })
+        .and_then(|p| de.end().map(|()| p).map_err(|e| json_error(e, ".", origin)))
+}
+
 /// Parses scene JSON without validating values. `origin` (the file, if any) and the line and
 /// column start the message of a JSON error; `default_name` names a scene without `name`.
 pub(super) fn parse(text: &str, origin: Option<&Path>, default_name: &str) -> Result<Scene, Error> {
@@ -253,6 +273,7 @@ impl SceneFile {
                 every: o.every.unwrap_or(super::DEFAULT_OUTPUT_EVERY),
                 fps: o.fps,
             },
+            probes: self.probes,
         })
     }
 
@@ -318,6 +339,7 @@ impl SceneFile {
                 every: Some(scene.output.every),
                 fps: scene.output.fps,
             }),
+            probes: scene.probes.clone(),
         }
     }
 }

@@ -76,7 +76,36 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
         }
         check_inside(i, b, &scene.containers, 2.0 * r)?;
     }
-    super::flow::check_flow(scene)
+    super::flow::check_flow(scene)?;
+    check_probes(scene)
+}
+
+/// The probes on their own and against the scene's gravity and containers; a rate of at most
+/// 1/dt_min, as for `output.fps`.
+fn check_probes(scene: &Scene) -> Result<(), Error> {
+    let Some(probes) = &scene.probes else {
+        return Ok(());
+    };
+    let containers: Vec<_> = scene
+        .containers
+        .iter()
+        .map(|c| crate::boundary::Aabb {
+            min: c.min.into(),
+            max: c.max.into(),
+        })
+        .collect();
+    probes.validate_for(scene.params.gravity, &containers)?;
+    if 1.0 / probes.rate < scene.params.dt_min {
+        return Err(Error::invalid(
+            "probes.rate",
+            probes.rate,
+            &format!(
+                "must be at most 1/dt_min ({} readings per second)",
+                1.0 / scene.params.dt_min
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// An obstacle-style mesh source (the obstacle or body mesh at JSON key `key`): a known

@@ -3,13 +3,14 @@
 //! Its methods are grouped by what they do: [`fill`] adds particles, containers and meshes,
 //! [`emitters`] and [`sinks`] add and remove fluid as the run goes, [`read`] reports
 //! particles and measures, [`stepping`] advances time, [`state`] exports and imports the
-//! exact state.
+//! exact state, and [`snapshot`] sorts the particles for the readings taken between steps.
 
 mod bodies;
 mod emitters;
 mod fill;
 mod read;
 mod sinks;
+mod snapshot;
 mod state;
 mod stepping;
 #[cfg(test)]
@@ -18,6 +19,7 @@ mod tests;
 pub use bodies::BodyId;
 pub use emitters::EmitterId;
 pub use sinks::SinkId;
+pub(crate) use snapshot::Snapshot;
 pub use state::{GridParts, WorldState};
 
 use crate::body::Body;

@@ -3,7 +3,7 @@
 //! ```text
 //! projfluid run SCENE [--duration SECONDS | --steps N] [--solver chebyshev|jacobi1|jacobi|cg|cg1|ldlt]
 //!                     [--rho R|auto] [--tau METRES] [--threads N] [--out DIR] [--every N] [--stats FILE]
-//!                     [--format vtp|vtk|vtk-ascii|ply] [--png DIR] [--png-width PIXELS]
+//!                     [--format vtp|vtk|vtk-ascii|ply] [--png DIR] [--png-width PIXELS] [--probes FILE]
 //!                     [--checkpoint-every N] [--checkpoint-dir DIR]
 //! projfluid run --resume FILE [--steps N | --duration SECONDS] [output options]
 //! projfluid scenes
@@ -23,6 +23,7 @@
 
 mod bench;
 mod frames;
+mod probes;
 mod run;
 mod tune_rho;
 mod validate;

@@ -11,15 +11,17 @@ pub(crate) use options::ParamOptions;
 
 use crate::Failure;
 use crate::frames::{FrameFormat, Frames};
+use crate::probes::ProbeLog;
 use crate::solver_parser;
 use clap::Args;
 use options::validate_naming_options;
 use print::print_summary;
 use progress::Progress;
 use projfluid::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
-use projfluid::scene::Scene;
+use projfluid::scene::{Scene, load_probes};
 use projfluid::{Error, SolverKind};
 use projfluid_lab::driver::{self, RunError, RunLength};
+use projfluid_lab::validation::hydrostatic::READING_TOLERANCE_PER_RADIUS;
 use std::fs::File;
 use std::io::Write;
 use std::path::PathBuf;
@@ -77,6 +79,10 @@ pub(crate) struct RunArgs {
     /// shortening the step before each to land on it, instead of every N steps.
     #[arg(long, value_name = "N")]
     fps: Option<f64>,
+    /// Read the probes in this JSON file (the value of a scene's `probes` key, replacing it)
+    /// into probes.csv in the output directory.
+    #[arg(long, value_name = "FILE")]
+    probes: Option<PathBuf>,
     /// Write the run summary as JSON to this file.
     #[arg(long, value_name = "FILE")]
     stats: Option<PathBuf>,
@@ -158,6 +164,17 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         args.png.as_deref().map(|dir| (dir, args.png_width)),
         &world,
     )?;
+    let mut probes = match (&scene.probes, &scene.output.dir) {
+        (Some(probes), Some(dir)) if args.resume.is_some() => {
+            Some(ProbeLog::resume(dir, probes.clone(), &world)?)
+        }
+        (Some(probes), Some(dir)) => {
+            let mut log = ProbeLog::create(dir, probes.clone())?;
+            log.record(&world)?;
+            Some(log)
+        }
+        _ => None,
+    };
     if args.resume.is_some() {
         // Frame k holds step k·every, or time k/fps; the frames up to now were written before.
         let last = match fps {
@@ -180,12 +197,18 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         world.boundary_count(),
         scene.params.solver.name()
     );
+    warn_about_loose_pressure_readings(&scene, &world);
     let mut progress = Progress::new(target);
     let length = match run_end {
         RunEnd::Time(end) => RunLength::UntilTime(end),
         RunEnd::Steps(n) => RunLength::UntilStep(n),
     };
-    let acc = driver::run_landing(&mut world, length, fps, |report| {
+    // Steps land on the frame times and on the probes' reading times.
+    let rates: Vec<f64> = fps
+        .into_iter()
+        .chain(scene.probes.as_ref().map(|p| p.rate))
+        .collect();
+    let acc = driver::run_landing(&mut world, length, &rates, |report| {
         let world = report.world;
         let due = match fps {
             Some(fps) => driver::frame_index(world.time(), fps).is_some(),
@@ -193,6 +216,9 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         };
         if due {
             frames.write(world)?;
+        }
+        if let Some(log) = probes.as_mut().filter(|log| log.due(world)) {
+            log.record(world)?;
         }
         if let Some(n) = args.checkpoint_every
             && world.steps() % n == 0
@@ -249,6 +275,9 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
     if let Some(d) = args.duration {
         scene.duration = d;
     }
+    if let Some(path) = &args.probes {
+        scene.probes = Some(load_probes(path).map_err(|e| Failure::Input(e.to_string()))?);
+    }
     if !(16..=8192).contains(&args.png_width) {
         return Err(Failure::Input(
             Error::invalid(
@@ -271,8 +300,34 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
         ("duration", "--duration", args.duration.is_some()),
     ]);
     validate_naming_options(scene, &options)?;
+    if scene.probes.is_some() && scene.output.dir.is_none() {
+        return Err(Failure::Input(
+            "the probes' readings go to probes.csv in the output directory: give output.dir \
+             or --out"
+                .into(),
+        ));
+    }
     Ok(match args.steps {
         Some(n) => RunLength::Steps(n),
         None => RunLength::Duration(scene.duration),
     })
+}
+
+/// Pressure probes read the constraint forces, which carry the water's weight only when the
+/// outer iteration is solved tightly (docs/method.md §10.3): says so on stderr when a run with
+/// pressure probes is solved more loosely than the hydrostatic validation's reading.
+fn warn_about_loose_pressure_readings(scene: &Scene, world: &projfluid::World) {
+    if scene.probes.as_ref().is_none_or(|p| p.pressure.is_empty()) {
+        return;
+    }
+    let p = world.params();
+    let tight = READING_TOLERANCE_PER_RADIUS * p.particle_radius;
+    if p.displacement_tolerance > tight * (1.0 + 1e-9) || p.density_tolerance > 0.0 {
+        eprintln!(
+            "warning: the pressure probes read the constraint forces, which are accurate only \
+             with solver.tau at most {tight:.2e} m and solver.eta 0 (this run: {:.2e} m and {}); \
+             see docs/method.md §10.3",
+            p.displacement_tolerance, p.density_tolerance
+        );
+    }
 }

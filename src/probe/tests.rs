@@ -1,0 +1,434 @@
+//! Probes in a settled tank, their determinism, and the checks of probe definitions.
+
+use super::*;
+use crate::scene::Scene;
+use crate::{Params, Vec3};
+use std::sync::OnceLock;
+
+/// Gravity (m/s²) and rest density (kg/m³) of the tank.
+const G: f64 = 9.81;
+const RHO0: f64 = 1000.0;
+
+/// What the settled tank showed.
+struct Settled {
+    /// Lattice spacing d (m).
+    spacing: f64,
+    /// N·V/area + d/2 (m): the height of the water's top face above the floor plane if the
+    /// water were at rest density (its bottom face is d/2 above the plane).
+    volume_surface: f64,
+    /// The mean height of the particles within d/2 of the highest one, plus d/2 (m): the top
+    /// face of the water as the particles show it, independently of the probes.
+    particle_surface: f64,
+    /// The probes read.
+    probes: ProbeSet,
+    /// Their reading at the end, after the tight-τ reading window.
+    reading: ProbeReading,
+    /// The gauges' reading with spray particles added above the water.
+    with_spray: Vec<f64>,
+}
+
+/// An 8 × 10 × 8 lattice (r = 2.5 cm, mass factor 1, the calm settings) in a closed tank with
+/// its walls d + r/4 from the lattice, as the CLI's hydrostatic validation builds it; relaxed
+/// for 10 s at 4/s, 2 s free, then 0.25 s solved to τ = 10⁻⁵·r with η = 0, the reading's
+/// tolerance of docs/validation.md (the pressures are read from forces, docs/method.md
+/// §10.3), and read; then spray is added and the gauges read again.
+fn settled_tank() -> &'static Settled {
+    static TANK: OnceLock<Settled> = OnceLock::new();
+    TANK.get_or_init(|| {
+        let r = 0.025;
+        let params = Params {
+            mass_factor: 1.0,
+            threads: 2,
+            ..Params::with_radius(r).calm()
+        };
+        let d = params.spacing();
+        let count = [8, 10, 8];
+        let gap = d + 0.25 * r;
+        let extent = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
+        let tank = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(extent(8), 1.5 * extent(10), extent(8)),
+        };
+        let mut world = World::new(params).unwrap();
+        world.add_container(tank, 1).unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(gap), count, Vec3::zeros())
+            .unwrap();
+        let (cx, cz) = (tank.max.x / 2.0, tank.max.z / 2.0);
+        let (ox, oz) = (cx + 0.37 * d, cz - 0.6 * d);
+        // In the fluid: at least H from the floor and the side walls, and 2H and more below the
+        // surface (about 0.51 m). On the walls: two side walls and the floor, at least H from
+        // their edges.
+        let probes = ProbeSet {
+            rate: 100.0,
+            gauges: vec![Gauge::new("centre", cx, cz), Gauge::new("off", ox, oz)],
+            pressure: vec![
+                PressureProbe::new("P10", [cx, 0.1, cz]),
+                PressureProbe::new("P20", [cx, 0.2, cz]),
+                PressureProbe::new("P30", [cx, 0.3, cz]),
+                PressureProbe::new("Q15", [ox, 0.15, oz]),
+                PressureProbe::new("Q25", [ox, 0.25, oz]),
+                PressureProbe::on_wall("wall_x", [0.0, 0.2, cz]),
+                PressureProbe::on_wall("wall_z", [cx, 0.3, 0.0]),
+                PressureProbe::on_wall("floor", [cx, 0.0, cz]),
+            ],
+        };
+        world.relax(10.0, 4.0).unwrap();
+        world.advance(2.0).unwrap();
+        world.set_density_tolerance(0.0).unwrap();
+        world.set_displacement_tolerance(1e-5 * r).unwrap();
+        world.advance(0.25).unwrap();
+        let reading = probes.read(&world).unwrap();
+
+        let positions = world.positions();
+        let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+        let layer: Vec<f64> = (positions.iter().map(|p| p.y))
+            .filter(|&y| y > top - 0.5 * d)
+            .collect();
+        let particle_surface = layer.iter().sum::<f64>() / layer.len() as f64 + 0.5 * d;
+        let volume = world.fluid_count() as f64 * world.particle_mass() / RHO0;
+        let area = (tank.max.x - d) * (tank.max.z - d);
+
+        // Spray: single droplets on both gauge lines 3 and 5 spacings above the water, and a
+        // clump of eight 6 spacings above it, each farther than H from the water.
+        let s = particle_surface;
+        let mut spray = vec![
+            Vec3::new(cx, s + 3.0 * d, cz),
+            Vec3::new(cx, s + 5.0 * d, cz),
+            Vec3::new(ox, s + 3.0 * d, oz),
+        ];
+        for i in 0..8 {
+            let corner = Vec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, (i >> 2) as f64);
+            spray.push(Vec3::new(ox, s + 6.0 * d, oz) + (corner - Vec3::repeat(0.5)) * d);
+        }
+        world.add_fluid_particles(&spray, None).unwrap();
+        let with_spray = probes.read(&world).unwrap().heights;
+        Settled {
+            spacing: d,
+            volume_surface: volume / area + 0.5 * d,
+            particle_surface,
+            probes,
+            reading,
+            with_spray,
+        }
+    })
+}
+
+/// The gauges read the water's height within one spacing of what its volume says, and spray
+/// above the water changes nothing.
+#[test]
+fn gauges_read_the_water_height_and_ignore_spray() {
+    let t = settled_tank();
+    for (gauge, height) in t.probes.gauges.iter().zip(&t.reading.heights) {
+        assert!(
+            (height - t.volume_surface).abs() <= t.spacing,
+            "{}: {height:.4} m, N·V/area + d/2 = {:.4} m",
+            gauge.name,
+            t.volume_surface
+        );
+        assert!(
+            (height - t.particle_surface).abs() <= 0.5 * t.spacing,
+            "{}: {height:.4} m, top layer + d/2 = {:.4} m",
+            gauge.name,
+            t.particle_surface
+        );
+    }
+    for (a, b) in t.reading.heights.iter().zip(&t.with_spray) {
+        assert!((a - b).abs() <= 1e-9, "spray moved a gauge from {a} to {b}");
+    }
+}
+
+/// Two support radii and more below the free surface, the probes read ρ0·g·depth within 5 %,
+/// in the fluid and on the walls; the depth is measured from the free surface the gauges read
+/// (checked against the particles and the volume above).
+#[test]
+fn pressure_probes_read_the_hydrostatic_pressure() {
+    let t = settled_tank();
+    let heights = &t.reading.heights;
+    let surface = heights.iter().sum::<f64>() / heights.len() as f64;
+    for (probe, p) in t.probes.pressure.iter().zip(&t.reading.pressures) {
+        let depth = surface - probe.position[1];
+        let expected = RHO0 * G * depth;
+        assert!(
+            (p / expected - 1.0).abs() <= 0.05,
+            "{}: {p:.0} Pa, rho0 g depth = {expected:.0} Pa (ratio {:.3})",
+            probe.name,
+            p / expected
+        );
+    }
+}
+
+/// A 6 × 4 × 6 lattice at rest in a half-metre box, before its first step.
+fn small_tank(threads: usize) -> World {
+    let mut world = World::new(Params {
+        threads,
+        ..Params::default()
+    })
+    .unwrap();
+    let tank = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.5),
+    };
+    world.add_container(tank, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(0.05), [6, 4, 6], Vec3::zeros())
+        .unwrap();
+    world
+}
+
+/// The ends of a gauge and the undefined readings: a dry bottom reads 0, a column over the
+/// top reads top − bottom, a dry floor less than a spacing; a probe in the air reads NaN, one
+/// on a dry wall 0, one on no wall NaN.
+#[test]
+fn gauge_ends_and_undefined_pressures() {
+    let world = small_tank(1);
+    let gauge = |name: &str, bottom: Option<f64>, top: Option<f64>| Gauge {
+        bottom,
+        top,
+        ..Gauge::new(name, 0.175, 0.175)
+    };
+    let probes = ProbeSet {
+        rate: 10.0,
+        gauges: vec![
+            gauge("floor", None, None),
+            gauge("dry", Some(0.3), None),
+            gauge("short", Some(0.05), Some(0.1)),
+            Gauge::new("dry_floor", 0.42, 0.42),
+        ],
+        pressure: vec![
+            PressureProbe::new("air", [0.25, 0.45, 0.25]),
+            PressureProbe::on_wall("lid", [0.25, 0.5, 0.25]),
+            PressureProbe::on_wall("nowhere", [0.25, 0.35, 0.25]),
+        ],
+    };
+    let reading = probes.read(&world).unwrap();
+    // The lattice's top centres are at 0.2 m, its top face at 0.225 m.
+    let h = reading.heights[0];
+    assert!((0.175..=0.25).contains(&h), "{h}");
+    assert_eq!(&reading.heights[1..3], &[0.0, 0.1 - 0.05]);
+    // A dry floor reads where the wall's own fraction falls to ½, within a spacing of it.
+    let dry = reading.heights[3];
+    assert!(dry > 0.0 && dry < world.params().spacing(), "{dry}");
+    assert!(reading.pressures[0].is_nan());
+    assert_eq!(reading.pressures[1], 0.0);
+    assert!(reading.pressures[2].is_nan());
+    assert_eq!(reading.time, 0.0);
+}
+
+/// The readings do not depend on the thread count: the same flow, stepped and read with one
+/// thread and with three, reads the same bits.
+#[test]
+fn readings_do_not_depend_on_the_thread_count() {
+    let probes = ProbeSet {
+        rate: 100.0,
+        gauges: vec![Gauge::new("H1", 0.1, 0.2), Gauge::new("H2", 0.3, 0.3)],
+        pressure: vec![
+            PressureProbe::new("P1", [0.1, 0.05, 0.2]),
+            PressureProbe::on_wall("W1", [0.0, 0.05, 0.25]),
+        ],
+    };
+    let read = |threads| {
+        let mut world = small_tank(threads);
+        for _ in 0..12 {
+            world.step().unwrap();
+        }
+        probes.read(&world).unwrap()
+    };
+    let (one, three) = (read(1), read(3));
+    let bits = |r: &ProbeReading| r.values().map(f64::to_bits).collect::<Vec<_>>();
+    assert_eq!(bits(&one), bits(&three));
+    assert!(one.values().all(f64::is_finite), "{one:?}");
+    assert!(one.pressures[1] > 0.0, "{one:?}");
+}
+
+/// Bad definitions are rejected with the key and the value.
+#[test]
+fn bad_probe_definitions_name_the_key() {
+    let good = ProbeSet {
+        rate: 50.0,
+        gauges: vec![Gauge::new("H1", 0.2, 0.2)],
+        pressure: vec![PressureProbe::new("P1", [0.2, 0.1, 0.2])],
+    };
+    good.validate().unwrap();
+    let message = |probes: ProbeSet| probes.validate().unwrap_err().to_string();
+    let with_gauge = |g: Gauge| ProbeSet {
+        gauges: vec![Gauge::new("H0", 0.1, 0.1), g],
+        ..good.clone()
+    };
+    let cases = [
+        (
+            ProbeSet {
+                rate: 0.0,
+                ..good.clone()
+            },
+            "probes.rate must be a positive finite number of readings per second, got 0",
+        ),
+        (
+            ProbeSet {
+                rate: f64::NAN,
+                ..good.clone()
+            },
+            "probes.rate must be a positive finite number of readings per second, got NaN",
+        ),
+        (
+            ProbeSet {
+                gauges: Vec::new(),
+                pressure: Vec::new(),
+                ..good.clone()
+            },
+            "probes must hold at least one gauge or pressure probe, got no probes",
+        ),
+        (
+            with_gauge(Gauge::new("", 0.1, 0.1)),
+            "probes.gauges[1].name must be 1 to 64 ASCII letters, digits, `_`, `-` or `.` \
+             (it names a CSV column), got \"\"",
+        ),
+        (
+            with_gauge(Gauge::new("H 2,", 0.1, 0.1)),
+            "probes.gauges[1].name must be 1 to 64 ASCII letters, digits, `_`, `-` or `.` \
+             (it names a CSV column), got \"H 2,\"",
+        ),
+        (
+            with_gauge(Gauge::new("P1", 0.1, 0.1)),
+            "probes.pressure[0].name must be unique among the probes (each names a CSV \
+             column), got `P1`",
+        ),
+        (
+            with_gauge(Gauge::new("H2", f64::NAN, 0.1)),
+            "probes.gauges[1].x must be a finite coordinate (m), got NaN",
+        ),
+        (
+            with_gauge(Gauge {
+                top: Some(f64::INFINITY),
+                ..Gauge::new("H2", 0.1, 0.1)
+            }),
+            "probes.gauges[1].top must be a finite coordinate (m), got inf",
+        ),
+        (
+            with_gauge(Gauge {
+                bottom: Some(0.5),
+                top: Some(0.2),
+                ..Gauge::new("H2", 0.1, 0.1)
+            }),
+            "probes.gauges[1].bottom must lie below top (0.2), got 0.5",
+        ),
+        (
+            ProbeSet {
+                pressure: vec![PressureProbe::new("P1", [0.0, f64::NAN, 0.0])],
+                ..good.clone()
+            },
+            "probes.pressure[0].position must be a finite point (m), got [0.0, NaN, 0.0]",
+        ),
+    ];
+    for (probes, expected) in cases {
+        assert_eq!(message(probes), expected);
+    }
+    // Against a world: gauges need gravity along −y and a floor under a gauge without a bottom.
+    let floor = [Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.5),
+    }];
+    good.validate_for([0.0, -9.81, 0.0], &floor).unwrap();
+    let err = good.validate_for([0.0, 0.0, -9.81], &floor).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "probes.gauges measure heights along y, so gravity must point along -y, \
+         got gravity [0.0, 0.0, -9.81]"
+    );
+    let outside = ProbeSet {
+        gauges: vec![Gauge::new("H1", 0.7, 0.2)],
+        ..good.clone()
+    };
+    let err = outside.validate_for([0.0, -9.81, 0.0], &floor).unwrap_err();
+    assert_eq!(
+        err.to_string(),
+        "probes.gauges[0].bottom must be given where no container's floor lies under the \
+         gauge at x = 0.7, z = 0.2, got none"
+    );
+    let world = small_tank(1);
+    assert_eq!(
+        outside.read(&world).unwrap_err(),
+        outside.validate_for([0.0, -9.81, 0.0], &floor).unwrap_err()
+    );
+    // Pressure probes alone need neither.
+    let pressure_only = ProbeSet {
+        gauges: Vec::new(),
+        ..good
+    };
+    pressure_only.validate_for([0.0, 0.0, 0.0], &[]).unwrap();
+}
+
+/// The scene key reads, validates against the scene and writes back.
+#[test]
+fn scene_key_probes_reads_and_round_trips() {
+    let scene_text = |probes: &str| {
+        format!(
+            r#"{{"particle_radius": 0.025, "container": {{"min": [0, 0, 0], "max": [0.5, 0.5, 0.5]}},
+                "fluid_blocks": [{{"start": [0.05, 0.05, 0.05], "count": [4, 4, 4]}}],
+                "duration": 0.1, "probes": {probes}}}"#
+        )
+    };
+    let probes = r#"{"rate": 200,
+        "gauges": [{"name": "H1", "x": 0.2, "z": 0.2}, {"name": "H2", "x": 0.3, "z": 0.1, "bottom": 0.05, "top": 0.4}],
+        "pressure": [{"name": "P1", "position": [0.2, 0.05, 0.2]}, {"name": "W1", "position": [0, 0.1, 0.2], "wall": true}]}"#;
+    let scene = Scene::from_json(&scene_text(probes)).unwrap();
+    let set = scene.probes.clone().unwrap();
+    assert_eq!(set.rate, 200.0);
+    assert_eq!(set.gauges[1].bottom, Some(0.05));
+    assert_eq!(set.gauges[0].top, None);
+    assert!(set.pressure[1].wall && !set.pressure[0].wall);
+    assert_eq!(set.columns(), ["H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(crate::scene::probes_from_json(probes).unwrap(), set);
+    let json = scene.to_json();
+    assert_eq!(Scene::from_json(&json).unwrap(), scene, "{json}");
+    let message = |text: &str| Scene::from_json(text).unwrap_err().to_string();
+    assert_eq!(
+        message(&scene_text(
+            r#"{"rate": 20000, "gauges": [{"name": "H", "x": 0.2, "z": 0.2}]}"#
+        )),
+        "probes.rate must be at most 1/dt_min (10000 readings per second), got 20000"
+    );
+    let unknown = message(&scene_text(
+        r#"{"rate": 20, "gauges": [{"name": "H", "x": 0.2, "z": 0.2, "y": 1}]}"#,
+    ));
+    assert!(
+        unknown.contains("probes.gauges[0]: unknown field `y`"),
+        "{unknown}"
+    );
+    let unknown = crate::scene::probes_from_json(r#"{"rate": 20, "gauge": []}"#)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        unknown.contains("probes: unknown field `gauge`"),
+        "{unknown}"
+    );
+    assert_eq!(
+        crate::scene::probes_from_json(r#"{"rate": 20}"#)
+            .unwrap_err()
+            .to_string(),
+        "probes must hold at least one gauge or pressure probe, got no probes"
+    );
+}
+
+/// The example of docs/scene-format.md reads in `dam_break_30k`, and its wall probe lies on
+/// the far wall's particles.
+#[test]
+fn documented_probes_example_is_valid() {
+    let doc = include_str!("../../docs/scene-format.md");
+    let example = doc
+        .split("```json\n")
+        .find(|block| block.starts_with("\"probes\""))
+        .and_then(|rest| rest.split("```").next())
+        .expect("docs/scene-format.md has a probes example");
+    let scene = Scene::builtin("dam_break_30k").unwrap().to_json();
+    let text = format!(
+        "{{{example}, {}",
+        scene.trim_start().trim_start_matches('{')
+    );
+    let scene = Scene::from_json(&text).unwrap();
+    let probes = scene.probes.unwrap();
+    assert_eq!(probes.columns(), ["H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(probes.rate, 100.0);
+    assert!(probes.pressure[1].wall);
+    assert_eq!(probes.pressure[1].position[0], scene.containers[0].max[0]);
+}

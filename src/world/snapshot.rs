@@ -1,0 +1,101 @@
+//! The particles as they stand between steps, sorted into a neighbour grid of their own: what
+//! the readings taken between steps (the constraint pressures, the probes) search, without
+//! touching the step's buffers.
+
+use super::World;
+use crate::Vec3;
+use crate::boundary::{Aabb, akinci_volumes};
+use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
+
+/// Fluid and boundary particles sorted into one grid of cell size H, the boundary with its
+/// Akinci masses.
+pub(crate) struct Snapshot {
+    /// The grid (cell size: the support radius H).
+    pub grid: UniformGrid,
+    /// Where each cell's fluid particles lie in `fluid`.
+    pub fluid_table: CellTable,
+    /// Fluid positions (m), in the order of `fluid_table`.
+    pub fluid: Vec<Vec3>,
+    /// `fluid` by component, for searches among them.
+    pub fluid_components: PointsByComponent,
+    /// Where each cell's boundary particles lie in `boundary`.
+    pub boundary_table: CellTable,
+    /// Boundary positions (m), in the order of `boundary_table`.
+    pub boundary: Vec<Vec3>,
+    /// `boundary` by component, for searches among them.
+    pub boundary_components: PointsByComponent,
+    /// Akinci mass ψ_b = ρ0·V_b (kg) of each of `boundary` (docs/method.md §2.6).
+    pub psi: Vec<f64>,
+}
+
+impl Snapshot {
+    /// For every query point, the fluid particles within the support radius `h` (m), as
+    /// indices into `fluid`, ascending.
+    pub fn fluid_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
+        let (table, points) = (&self.fluid_table, &self.fluid_components);
+        self.grid.search_in(table, points, queries, h, false, out);
+    }
+
+    /// For every query point, the boundary particles within the support radius `h` (m), as
+    /// indices into `boundary`, ascending.
+    pub fn boundary_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
+        let (table, points) = (&self.boundary_table, &self.boundary_components);
+        self.grid.search_in(table, points, queries, h, false, out);
+    }
+}
+
+impl World {
+    /// The fluid and boundary particles sorted into a fresh grid, or `None` when there are
+    /// none. Runs on the caller's thread pool (call it inside the world's). Before the first
+    /// step the boundary has no masses yet; they are then computed here as the step would,
+    /// over the boundary particles there are.
+    pub(crate) fn snapshot(&self) -> Option<Snapshot> {
+        let h = self.params.support_radius();
+        let fluid = &self.fluid.positions;
+        let boundary = &self.boundary;
+        let bounds = [fluid.as_slice(), &boundary.positions]
+            .iter()
+            .filter_map(|p| Aabb::around(p))
+            .reduce(|a, b| a.union(&b))?;
+        let grid = UniformGrid::covering(bounds.min, bounds.max, h);
+        let sorted = |points: &[Vec3], table: &mut CellTable| {
+            let mut order = Vec::new();
+            grid.sort(points, &mut order, table);
+            order
+        };
+        let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
+        let fluid_order = sorted(fluid, &mut fluid_table);
+        let boundary_order = sorted(&boundary.positions, &mut boundary_table);
+        let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
+        let bx: Vec<Vec3> = boundary_order
+            .iter()
+            .map(|&i| boundary.positions[i as usize])
+            .collect();
+        let (mut fluid_components, mut boundary_components) =
+            (PointsByComponent::default(), PointsByComponent::default());
+        fluid_components.fill(&fluid);
+        boundary_components.fill(&bx);
+        let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
+            boundary_order
+                .iter()
+                .map(|&i| boundary.psi[i as usize])
+                .collect()
+        } else {
+            let kernel = &self.constraint.kernel;
+            akinci_volumes(&grid, &boundary_table, &bx, &boundary_components, kernel)
+                .into_iter()
+                .map(|v| v * self.params.rest_density)
+                .collect()
+        };
+        Some(Snapshot {
+            grid,
+            fluid_table,
+            fluid,
+            fluid_components,
+            boundary_table,
+            boundary: bx,
+            boundary_components,
+            psi,
+        })
+    }
+}

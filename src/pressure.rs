@@ -10,9 +10,7 @@
 //! It is a reading of the constraint forces (their magnitude is set by the force balance, not
 //! by an equation of state), and as such needs a tight outer tolerance to be accurate.
 
-use crate::boundary::Aabb;
-use crate::constraint::{Corrections, Neighborhood, Projection};
-use crate::neighbors::{CellTable, NeighborLists, UniformGrid};
+use crate::constraint::{Corrections, Projection};
 use crate::{Vec3, World};
 
 /// Pressures estimated from the constraint forces at the current positions.
@@ -31,62 +29,18 @@ impl World {
     /// position (see the module docs), with that position, in storage order; and the mean
     /// vertical constraint force per particle (N).
     pub fn constraint_pressures(&self) -> ConstraintPressures {
-        let world = self;
-        let params = &world.params;
-        let h = params.support_radius();
-        let fluid = &world.fluid.positions;
-        let boundary = &world.boundary;
-        let bounds = [fluid.as_slice(), &boundary.positions]
-            .iter()
-            .filter_map(|p| Aabb::around(p))
-            .reduce(|a, b| a.union(&b));
-        let Some(bounds) = bounds else {
-            return ConstraintPressures::default();
-        };
-        world.pool.install(|| {
-            let grid = UniformGrid::covering(bounds.min, bounds.max, h);
-            let sorted = |points: &[Vec3], table: &mut CellTable| {
-                let mut order = Vec::new();
-                grid.sort(points, &mut order, table);
-                order
-            };
-            let (mut fluid_table, mut boundary_table) =
-                (CellTable::default(), CellTable::default());
-            let fluid_order = sorted(fluid, &mut fluid_table);
-            let boundary_order = sorted(&boundary.positions, &mut boundary_table);
-            let x: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
-            let bx: Vec<Vec3> = boundary_order
-                .iter()
-                .map(|&i| boundary.positions[i as usize])
-                .collect();
-            let psi: Vec<f64> = boundary_order
-                .iter()
-                .map(|&i| boundary.psi[i as usize])
-                .collect();
-            let (mut fluid_lists, mut boundary_lists) =
-                (NeighborLists::default(), NeighborLists::default());
-            grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
-            grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
-            let mut weights = Vec::new();
-            world.constraint.weights(&fluid_lists, &mut weights);
-            let nb = Neighborhood {
-                fluid: &fluid_lists,
-                boundary: &boundary_lists,
-                boundary_positions: &bx,
-                boundary_psi: &psi,
-                weights: &weights,
-            };
+        let params = &self.params;
+        self.with_snapshot(|snapshot| {
+            let (x, nb) = (snapshot.x, snapshot.nb);
             let (mut projections, mut corrections) =
                 (Vec::<Projection>::new(), Corrections::default());
-            world
-                .constraint
-                .project(&x, &nb, &mut projections, &mut corrections);
-            let volume = world.constraint.mass / world.constraint.rest_density;
+            let c = &self.constraint;
+            c.project(x, nb, &mut projections, &mut corrections);
+            let volume = c.mass / c.rest_density;
             // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
             // step gathers it.
-            let c = &world.constraint;
             let mut gathered = vec![Vec3::zeros(); x.len()];
-            c.gathered_corrections(0, &x, &nb, &projections, &corrections, &mut gathered);
+            c.gathered_corrections(0, x, nb, &projections, &corrections, &mut gathered);
             let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
             let support = force_sum * params.stiffness / x.len().max(1) as f64;
             let pressures = x
@@ -94,7 +48,7 @@ impl World {
                 .zip(&projections)
                 .enumerate()
                 .map(|(i, (p, proj))| {
-                    let weight = c.membership(&fluid_lists, i);
+                    let weight = c.membership(nb.fluid, i);
                     (*p, -params.stiffness * proj.lambda * weight / volume)
                 })
                 .collect();
@@ -103,5 +57,6 @@ impl World {
                 mean_vertical_force: support,
             }
         })
+        .unwrap_or_default()
     }
 }

@@ -10,6 +10,7 @@ mod emitters;
 mod fill;
 mod read;
 mod sinks;
+mod snapshot;
 mod state;
 mod stepping;
 #[cfg(test)]

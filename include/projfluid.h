@@ -201,7 +201,8 @@ typedef struct PfParams {
      */
     double rest_density;
     /**
-     * Particle mass as a fraction of ρ0·(2r)³. Default 0.8.
+     * Particle mass as a fraction of ρ0·(2r)³ (dimensionless). Default ≈ 1.0000275, at which
+     * a cubic lattice of spacing 2r starts at ρ0; 0.8 is the convention of other SPH codes.
      */
     double mass_factor;
     /**

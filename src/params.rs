@@ -207,7 +207,9 @@ pub struct Params {
     pub particle_radius: f64,
     /// Rest density ρ0 (kg/m³).
     pub rest_density: f64,
-    /// Particle mass as a fraction of ρ0·(2r)³ (0.8 in the reference implementation).
+    /// Particle mass as a fraction of ρ0·(2r)³ (dimensionless). The default,
+    /// [`rest_mass_factor`], makes a lattice block start at ρ0;
+    /// [`REFERENCE_MASS_FACTOR`] (0.8) is the convention of other SPH codes.
     pub mass_factor: f64,
     /// Constraint stiffness k (N/m).
     pub stiffness: f64,
@@ -282,6 +284,29 @@ pub const DEFAULT_TOLERANCE_PER_RADIUS: f64 = 3e-3;
 /// at 0.2–0.3 cm/s after 2 s, at 3e-3 still at 1.5–4 cm/s (docs/validation.md, "Tank at rest").
 pub const CALM_TOLERANCE_PER_RADIUS: f64 = 3e-4;
 
+/// The mass factor of SPH codes that take a particle's volume as 0.8·(2r)³ (SPlisHSPlasH
+/// among them): a lattice block then starts at 0.8·ρ0 and settles about 7 % lower than it
+/// was built (docs/method.md §2.2). Offered for comparison with such codes.
+pub const REFERENCE_MASS_FACTOR: f64 = 0.8;
+
+/// The mass factor at which a cubic lattice of spacing 2r has density ρ0 in its interior:
+/// 1/((2r)³·Σ_j W(x_j)) over the lattice points within H = 4r (≈ 1.0000275 for the cubic
+/// spline; docs/method.md §2.2). The sum is scale free, so it is evaluated at 2r = 1.
+pub fn rest_mass_factor() -> f64 {
+    let kernel = crate::kernel::CubicKernel::new(2.0);
+    let reach = -2..=2i32;
+    let sum: f64 = reach
+        .clone()
+        .flat_map(|i| {
+            reach
+                .clone()
+                .flat_map(move |j| (-2..=2).map(move |k| (i, j, k)))
+        })
+        .map(|(i, j, k)| kernel.w(f64::from(i * i + j * j + k * k).sqrt()))
+        .sum();
+    1.0 / sum
+}
+
 impl Default for Params {
     fn default() -> Self {
         Self::with_radius(DEFAULT_PARTICLE_RADIUS)
@@ -294,7 +319,7 @@ impl Params {
         Self {
             particle_radius: r,
             rest_density: 1000.0,
-            mass_factor: 0.8,
+            mass_factor: rest_mass_factor(),
             stiffness: 5e4,
             gravity: [0.0, -9.81, 0.0],
             solver: SolverKind::Chebyshev,
@@ -350,7 +375,8 @@ impl Params {
     }
 
     /// Stencil size of a fluid at rest density: the number of particles of mass m within
-    /// the support radius H, c = ρ0·(4/3)πH³/m (33.5 at mass factor 1, 41.9 at 0.8).
+    /// the support radius H, c = ρ0·(4/3)πH³/m (33.5 at the default mass factor, 41.9 at
+    /// 0.8).
     pub fn rest_stencil_size(&self) -> f64 {
         self.rest_density * 4.0 / 3.0 * std::f64::consts::PI * self.support_radius().powi(3)
             / self.particle_mass()

@@ -11,7 +11,6 @@
 //! by an equation of state), and as such needs a tight outer tolerance to be accurate.
 
 use crate::constraint::{Corrections, Neighborhood, Projection};
-use crate::neighbors::NeighborLists;
 use crate::world::Snapshot;
 use crate::{Vec3, World};
 
@@ -46,37 +45,28 @@ impl World {
     /// The pressure estimate (Pa) of every fluid particle of `snapshot`, in its order, and the
     /// mean vertical constraint force per particle (N). Runs on the caller's thread pool.
     pub(crate) fn pressure_field(&self, snapshot: &Snapshot) -> (Vec<f64>, f64) {
+        self.with_neighborhood(snapshot, |nb| self.pressures_in(&snapshot.fluid, nb))
+    }
+
+    /// The pressure estimates (Pa) of the fluid particles at `x` with neighbourhood `nb`, and
+    /// the mean vertical constraint force per particle (N).
+    fn pressures_in(&self, x: &[Vec3], nb: &Neighborhood) -> (Vec<f64>, f64) {
         let params = &self.params;
-        let h = params.support_radius();
-        let (grid, x, bx) = (&snapshot.grid, &snapshot.fluid, &snapshot.boundary);
-        let (mut fluid_lists, mut boundary_lists) =
-            (NeighborLists::default(), NeighborLists::default());
-        grid.search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists);
-        snapshot.boundary_near(x, h, &mut boundary_lists);
         let c = &self.constraint;
-        let mut weights = Vec::new();
-        c.weights(&fluid_lists, &mut weights);
-        let nb = Neighborhood {
-            fluid: &fluid_lists,
-            boundary: &boundary_lists,
-            boundary_positions: bx,
-            boundary_psi: &snapshot.psi,
-            weights: &weights,
-        };
         let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
-        c.project(x, &nb, &mut projections, &mut corrections);
+        c.project(x, nb, &mut projections, &mut corrections);
         let volume = c.mass / c.rest_density;
         // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
         // step gathers it.
         let mut gathered = vec![Vec3::zeros(); x.len()];
-        c.gathered_corrections(0, x, &nb, &projections, &corrections, &mut gathered);
+        c.gathered_corrections(0, x, nb, &projections, &corrections, &mut gathered);
         let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
         let support = force_sum * params.stiffness / x.len().max(1) as f64;
         let pressures = projections
             .iter()
             .enumerate()
             .map(|(i, proj)| {
-                let weight = c.membership(&fluid_lists, i);
+                let weight = c.membership(nb.fluid, i);
                 -params.stiffness * proj.lambda * weight / volume
             })
             .collect();

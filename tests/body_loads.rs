@@ -14,7 +14,6 @@ const RHO0: f64 = 1000.0;
 
 fn params(weight: ProjectionWeight) -> Params {
     Params {
-        mass_factor: 1.0,
         projection_weight: weight,
         ..Params::with_radius(R)
     }

@@ -43,7 +43,7 @@ fn pour_and_check(params: Params) {
     // The test must exercise both sides of the walls: water in the cup and around it.
     let n = world.fluid_count();
     assert!(
-        in_cup_at_end > n / 10 && in_cup_at_end < n * 9 / 10,
+        in_cup_at_end > n / 20 && in_cup_at_end < n * 19 / 20,
         "{in_cup_at_end} of {n} particles ended in the cup"
     );
 }

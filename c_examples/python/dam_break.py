@@ -120,9 +120,11 @@ def main():
             lib.pf_world_add_container_box(world, vec3(0, 0, 0), vec3(0.8, 0.6, 0.3), 1),
             "pf_world_add_container_box",
         )
+        # The first particle centres 2r + r/4 from the walls, so that the fluid, which starts
+        # at rest density, starts compressed nowhere (not even in the corners).
         count = (c_size_t * 3)(6, 10, 5)
         check(
-            lib.pf_world_add_fluid_box(world, vec3(0.03, 0.03, 0.03), count, None),
+            lib.pf_world_add_fluid_box(world, vec3(0.045, 0.045, 0.045), count, None),
             "pf_world_add_fluid_box",
         )
 

@@ -64,7 +64,8 @@ pub struct PfParams {
     pub particle_radius: f64,
     /// Rest density ρ0 (kg/m³). Default 1000.
     pub rest_density: f64,
-    /// Particle mass as a fraction of ρ0·(2r)³. Default 0.8.
+    /// Particle mass as a fraction of ρ0·(2r)³ (dimensionless). Default ≈ 1.0000275, at which
+    /// a cubic lattice of spacing 2r starts at ρ0; 0.8 is the convention of other SPH codes.
     pub mass_factor: f64,
     /// Constraint stiffness k (N/m). Default 5e4.
     pub stiffness: f64,

@@ -7,7 +7,7 @@ use crate::{Error, Vec3, reduce};
 
 impl World {
     /// Copies a per-particle quantity into `out` in ascending id order.
-    fn gather_by_id<T: Copy>(&self, values: &[T], out: &mut [T]) {
+    pub(super) fn gather_by_id<T: Copy>(&self, values: &[T], out: &mut [T]) {
         for (v, &id) in values.iter().zip(&self.fluid.ids) {
             out[self.fluid.rank(id)] = *v;
         }

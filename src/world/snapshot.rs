@@ -5,6 +5,7 @@
 use super::World;
 use crate::Vec3;
 use crate::boundary::{Aabb, akinci_volumes};
+use crate::constraint::Neighborhood;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 
 /// Fluid and boundary particles sorted into one grid of cell size H, the boundary with its
@@ -16,6 +17,8 @@ pub(crate) struct Snapshot {
     pub fluid_table: CellTable,
     /// Fluid positions (m), in the order of `fluid_table`.
     pub fluid: Vec<Vec3>,
+    /// The storage index in the world of the particle at each of `fluid`.
+    pub fluid_order: Vec<u32>,
     /// `fluid` by component, for searches among them.
     pub fluid_components: PointsByComponent,
     /// Where each cell's boundary particles lie in `boundary`.
@@ -91,11 +94,63 @@ impl World {
             grid,
             fluid_table,
             fluid,
+            fluid_order,
             fluid_components,
             boundary_table,
             boundary: bx,
             boundary_components,
             psi,
         })
+    }
+
+    /// Runs `read` with the neighbourhood of every fluid particle of `snapshot` (its fluid and
+    /// boundary neighbours within the support radius, with the projection weights), indexed
+    /// in the snapshot's order. Runs on the caller's thread pool.
+    pub(crate) fn with_neighborhood<R>(
+        &self,
+        snapshot: &Snapshot,
+        read: impl FnOnce(&Neighborhood) -> R,
+    ) -> R {
+        let h = self.params.support_radius();
+        let x = &snapshot.fluid;
+        let (mut fluid_lists, mut boundary_lists) =
+            (NeighborLists::default(), NeighborLists::default());
+        snapshot
+            .grid
+            .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists);
+        snapshot.boundary_near(x, h, &mut boundary_lists);
+        let mut weights = Vec::new();
+        self.constraint.weights(&fluid_lists, &mut weights);
+        read(&Neighborhood {
+            fluid: &fluid_lists,
+            boundary: &boundary_lists,
+            boundary_positions: &snapshot.boundary,
+            boundary_psi: &snapshot.psi,
+            weights: &weights,
+        })
+    }
+
+    /// The SPH density ρ_i (kg/m³) of every fluid particle at its current position, in
+    /// ascending id order (see [`World::ids`]). Unlike [`World::densities`], which reports
+    /// the densities the last step ended with, this evaluates them now: before the first step
+    /// it shows whether the fluid starts at rest density, against walls and obstacles too.
+    pub fn current_densities(&self) -> Vec<f64> {
+        let in_storage_order = self.pool.install(|| {
+            let Some(snapshot) = self.snapshot() else {
+                return Vec::new();
+            };
+            let mut rho = Vec::new();
+            self.with_neighborhood(&snapshot, |nb| {
+                self.constraint.densities(&snapshot.fluid, nb, &mut rho)
+            });
+            let mut out = vec![0.0; rho.len()];
+            for (&k, value) in snapshot.fluid_order.iter().zip(rho) {
+                out[k as usize] = value;
+            }
+            out
+        });
+        let mut out = vec![0.0; self.fluid_count()];
+        self.gather_by_id(&in_storage_order, &mut out);
+        out
     }
 }

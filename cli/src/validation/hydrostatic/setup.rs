@@ -98,7 +98,7 @@ impl Setup {
         Ok(())
     }
 
-    /// The tank at t = 0: the block at rest density (mass factor 1) with its centres one
+    /// The tank at t = 0: the block at rest density (the default mass factor) with its centres one
     /// spacing plus r/4 from the walls, and a lid well above it.
     pub fn build(&self) -> Result<(World, Aabb), Error> {
         self.validate()?;
@@ -107,7 +107,6 @@ impl Setup {
             defaults = defaults.calm();
         }
         let params = Params {
-            mass_factor: 1.0,
             solver: self.solver,
             threads: self.threads,
             displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),

@@ -82,14 +82,13 @@ impl Setup {
         (1.0 + 2.0 * self.n() * self.duration).ceil() + 1.0
     }
 
-    /// The world at t = 0 and the tank it stands in. Particle mass factor 1, so that the
+    /// The world at t = 0 and the tank it stands in. At the default mass factor the
     /// column starts at rest density and does not first settle.
     pub fn build(&self) -> Result<(World, Aabb), Error> {
         self.validate()?;
         let a = COLUMN_WIDTH;
         let d = self.spacing();
         let params = Params {
-            mass_factor: 1.0,
             solver: self.solver,
             threads: self.threads,
             ..Params::with_radius(0.5 * d)

@@ -273,12 +273,13 @@ fn chebyshev_needs_fewer_outer_iterations_than_plain() {
 /// The global solvers that solve A·x = b (exactly or to 1e-10) give the same physics on the
 /// diagonal formulation, and one CG iteration per outer iteration does not.
 ///
-/// Over the first 10 steps of the small dam break (free fall, no constraint active yet) the
-/// converging solvers agree with one exact Jacobi sweep to 1e-10 of the container size. Once
-/// constraints switch on (step 11), round-off-level differences are amplified by the
-/// constraint activation (even LDLᵀ and Jacobi, both exact to round-off, then differ by
-/// ~1e-6 of the container size), so after 20 steps the converging solvers are only required to
-/// agree to 1e-5 of the container size, while cg1 must differ by more than 1e-3 of it.
+/// Over the first 3 steps of the small dam break the converging solvers agree with one exact
+/// Jacobi sweep to 1e-10 of the container size. The fluid starts at rest density, so its
+/// constraints are active from the start, and from step 4 on round-off-level differences
+/// move a stopping decision by one outer iteration (even LDLᵀ and Jacobi, both exact to
+/// round-off, then differ by ~1e-7 of the container size, ~7e-5 after 20 steps), so after 20
+/// steps the converging solvers are only required to agree to 1e-4 of the container size,
+/// while cg1 must differ by more than 1e-3 of it.
 #[test]
 fn converging_global_solvers_agree_and_cg1_differs() {
     let run_steps = |solver: SolverKind, steps: usize| {
@@ -300,7 +301,7 @@ fn converging_global_solvers_agree_and_cg1_differs() {
             .map(|(a, b)| (a - b).norm())
             .fold(0.0, f64::max)
     };
-    for (steps, tolerance) in [(10, 1e-10), (20, 1e-5)] {
+    for (steps, tolerance) in [(3, 1e-10), (20, 1e-4)] {
         let reference = run_steps(SolverKind::Jacobi1, steps);
         for solver in [SolverKind::Cg, SolverKind::Ldlt, SolverKind::Jacobi] {
             let d = max_difference(&run_steps(solver, steps), &reference);

@@ -30,6 +30,10 @@ impl World {
     /// The pressure estimate p_i = −k·λ_i·w_i/V (Pa) of every fluid particle at its current
     /// position (see the module docs), with that position, in storage order; and the mean
     /// vertical constraint force per particle (N).
+    ///
+    /// # Panics
+    /// When memory for the neighbour lists and projections cannot be had (a diagnostic for
+    /// validation runs, not part of the C API).
     pub fn constraint_pressures(&self) -> ConstraintPressures {
         let world = self;
         let params = &world.params;
@@ -44,10 +48,11 @@ impl World {
             return ConstraintPressures::default();
         };
         world.pool.install(|| {
-            let grid = UniformGrid::covering(bounds.min, bounds.max, h);
+            let out_of_memory = "out of memory for the pressure estimate";
+            let grid = UniformGrid::covering(bounds.min, bounds.max, h).expect(out_of_memory);
             let sorted = |points: &[Vec3], table: &mut CellTable| {
                 let mut order = Vec::new();
-                grid.sort(points, &mut order, table);
+                grid.sort(points, &mut order, table).expect(out_of_memory);
                 order
             };
             let (mut fluid_table, mut boundary_table) =
@@ -65,8 +70,10 @@ impl World {
                 .collect();
             let (mut fluid_lists, mut boundary_lists) =
                 (NeighborLists::default(), NeighborLists::default());
-            grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists);
-            grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists);
+            grid.search(&fluid_table, &x, &x, h, true, &mut fluid_lists)
+                .expect(out_of_memory);
+            grid.search(&boundary_table, &bx, &x, h, false, &mut boundary_lists)
+                .expect(out_of_memory);
             let mut weights = Vec::new();
             world.constraint.weights(&fluid_lists, &mut weights);
             let nb = Neighborhood {
@@ -80,7 +87,8 @@ impl World {
                 (Vec::<Projection>::new(), Corrections::default());
             world
                 .constraint
-                .project(&x, &nb, &mut projections, &mut corrections);
+                .project(&x, &nb, &mut projections, &mut corrections)
+                .expect(out_of_memory);
             let volume = world.constraint.mass / world.constraint.rest_density;
             // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
             // step gathers it.

@@ -5,6 +5,7 @@ use crate::Vec3;
 use crate::kernel::CubicKernel;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 pub mod mesh;
 mod particles;
@@ -12,7 +13,7 @@ pub mod shapes;
 pub mod transform;
 pub mod winding;
 
-pub(crate) use particles::Boundary;
+pub(crate) use particles::{Boundary, BoundaryCopy};
 pub use transform::Transform;
 
 /// The owner index of boundary particles that belong to walls and static obstacles rather
@@ -103,13 +104,14 @@ pub(crate) fn sample_box_walls_into(
 /// `points` sorted by `table` on `grid` (`by_component`: the same points by component), in
 /// m³. The neighbours are searched [`VOLUME_BATCH`] particles at a time, so that only one
 /// batch's lists are held (a whole boundary's were once the largest allocation of a world).
+/// Errors when memory for the volumes or a batch's lists cannot be had.
 pub fn akinci_volumes(
     grid: &UniformGrid,
     table: &CellTable,
     points: &[Vec3],
     by_component: &PointsByComponent,
     kernel: &CubicKernel,
-) -> Vec<f64> {
+) -> Result<Vec<f64>, TryReserveError> {
     volumes_in_batches(grid, table, points, by_component, kernel, VOLUME_BATCH)
 }
 
@@ -124,13 +126,14 @@ fn volumes_in_batches(
     by_component: &PointsByComponent,
     kernel: &CubicKernel,
     batch: usize,
-) -> Vec<f64> {
+) -> Result<Vec<f64>, TryReserveError> {
     let mut lists = NeighborLists::default();
-    let mut volumes = Vec::with_capacity(points.len());
+    let mut volumes = Vec::new();
+    volumes.try_reserve_exact(points.len())?;
     let h = kernel.support_radius();
     for first in (0..points.len()).step_by(batch) {
         let queries = &points[first..first.saturating_add(batch).min(points.len())];
-        grid.search_from(table, by_component, queries, Some(first), h, &mut lists);
+        grid.search_from(table, by_component, queries, Some(first), h, &mut lists)?;
         volumes.par_extend(queries.par_iter().enumerate().map(|(k, x)| {
             let sum: f64 = lists
                 .of(k)
@@ -140,27 +143,32 @@ fn volumes_in_batches(
             1.0 / (kernel.w_zero() + sum)
         }));
     }
-    volumes
+    Ok(volumes)
 }
 
 /// Akinci masses ψ = ρ0·V (kg) of `points` (m) computed over these points alone, in their
-/// order: the masses of a body's particles in its own frame.
-pub(crate) fn own_masses(points: &[Vec3], kernel: &CubicKernel, rest_density: f64) -> Vec<f64> {
+/// order: the masses of a body's particles in its own frame. Errors when memory for the
+/// grid, the sort or the search cannot be had.
+pub(crate) fn own_masses(
+    points: &[Vec3],
+    kernel: &CubicKernel,
+    rest_density: f64,
+) -> Result<Vec<f64>, TryReserveError> {
     let Some(bounds) = Aabb::around(points) else {
-        return Vec::new();
+        return Ok(Vec::new());
     };
-    let grid = UniformGrid::covering(bounds.min, bounds.max, kernel.support_radius());
+    let grid = UniformGrid::covering(bounds.min, bounds.max, kernel.support_radius())?;
     let (mut order, mut table) = (Vec::new(), CellTable::default());
-    grid.sort(points, &mut order, &mut table);
+    grid.sort(points, &mut order, &mut table)?;
     let sorted: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
     let mut by_component = PointsByComponent::default();
-    by_component.fill(&sorted);
-    let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, kernel);
+    by_component.fill(&sorted)?;
+    let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, kernel)?;
     let mut psi = vec![0.0; points.len()];
     for (&i, v) in order.iter().zip(volumes) {
         psi[i as usize] = v * rest_density;
     }
-    psi
+    Ok(psi)
 }
 
 #[cfg(test)]
@@ -207,14 +215,14 @@ mod tests {
         let pts: Vec<Vec3> = (0..41)
             .flat_map(|i| (0..41).map(move |k| Vec3::new(i as f64 * s, 0.0, k as f64 * s)))
             .collect();
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::new(1.0, 0.0, 1.0), 0.1);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::new(1.0, 0.0, 1.0), 0.1).unwrap();
         let mut table = CellTable::default();
         let mut order = Vec::new();
-        grid.sort(&pts, &mut order, &mut table);
+        grid.sort(&pts, &mut order, &mut table).unwrap();
         let sorted: Vec<Vec3> = order.iter().map(|&i| pts[i as usize]).collect();
         let mut by_component = PointsByComponent::default();
-        by_component.fill(&sorted);
-        let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, &kernel);
+        by_component.fill(&sorted).unwrap();
+        let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, &kernel).unwrap();
         let centre = sorted
             .iter()
             .position(|p| (p - Vec3::new(0.5, 0.0, 0.5)).norm() < 1e-9)
@@ -229,10 +237,12 @@ mod tests {
         assert!(volumes[corner] > 2.0 * volumes[centre]);
         // Searched in batches of any size (one point, a few, or more than a cell's), every
         // volume comes out bit for bit as from one search of all points.
-        let whole = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, usize::MAX);
+        let whole =
+            volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, usize::MAX).unwrap();
         assert_eq!(volumes, whole);
         for batch in [1, 7, 100, 1000] {
-            let parts = volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, batch);
+            let parts =
+                volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, batch).unwrap();
             assert_eq!(parts, whole, "batches of {batch}");
         }
     }

@@ -233,6 +233,11 @@ impl Emitter {
         }
     }
 
+    /// Puts back the progress `state` (of this emitter, taken before a step that failed).
+    pub(crate) fn restore(&mut self, state: &EmitterState) {
+        self.state = *state;
+    }
+
     /// Adds a step of `dt` seconds to the last layer's travel.
     pub(crate) fn advance(&mut self, dt: f64) {
         self.state.travelled += self.state.spec.speed * dt;

@@ -51,6 +51,17 @@ impl Fluid {
         self.next_id = first + count;
     }
 
+    /// Removes the particles added since the fluid held `len` particles and gave out ids
+    /// below `next_id` (those added last, with the last ids), as if never added.
+    pub fn truncate(&mut self, len: usize, next_id: u64) {
+        self.positions.truncate(len);
+        self.velocities.truncate(len);
+        self.densities.truncate(len);
+        self.ids.truncate(len);
+        self.ascending.truncate(len);
+        self.next_id = next_id;
+    }
+
     /// The place of particle `id` (which must be stored) in ascending id order: the id itself
     /// while nothing was removed, else its index in [`Fluid::ascending`].
     #[inline]

@@ -12,6 +12,12 @@ mod xsph;
 
 /// A force other than pressure, applied to the fluid's velocities at the end of a step.
 pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
+    /// Reserves the force's buffers for `particles` fluid particles, so that applying it
+    /// allocates nothing; errors when the memory cannot be had. The default has none.
+    fn try_reserve(&mut self, _particles: usize) -> Result<(), std::collections::TryReserveError> {
+        Ok(())
+    }
+
     /// Changes `fluid.velocities` (m/s) given the final positions and densities and the
     /// step's neighbourhoods; `scratch` is a per-particle buffer the force may use.
     fn apply(

@@ -29,6 +29,10 @@ impl World {
     /// The pressure estimate p_i = −k·λ_i·w_i/V (Pa) of every fluid particle at its current
     /// position (see the module docs), with that position; and the mean vertical constraint
     /// force per particle (N).
+    ///
+    /// # Panics
+    /// When memory for the neighbour lists and projections cannot be had (a reading for
+    /// the Rust API and the tools, not part of the C API).
     pub fn constraint_pressures(&self) -> ConstraintPressures {
         self.pool.install(|| {
             let Some(snapshot) = self.snapshot() else {
@@ -54,7 +58,8 @@ impl World {
         let params = &self.params;
         let c = &self.constraint;
         let (mut projections, mut corrections) = (Vec::<Projection>::new(), Corrections::default());
-        c.project(x, nb, &mut projections, &mut corrections);
+        c.project(x, nb, &mut projections, &mut corrections)
+            .expect("out of memory for the pressure estimate");
         let volume = c.mass / c.rest_density;
         // Σ_i k·(P_ij − x_j): the constraint force on each particle, gathered as the global
         // step gathers it.

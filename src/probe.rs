@@ -167,7 +167,7 @@ impl ProbeSet {
     /// the water's weight only as accurately as the outer iteration converged (a tight τ
     /// and η = 0 for a reading within a few per cent, docs/method.md §10.3). Deterministic for
     /// any thread count. Errors: the checks of [`ProbeSet::validate_for`] with the world's
-    /// gravity and containers.
+    /// gravity and containers. Panics when the memory for the reading cannot be had.
     pub fn read(&self, world: &World) -> Result<ProbeReading, Error> {
         self.validate_for(world.params().gravity, world.containers())?;
         let lines: Vec<gauge::Line> = self

@@ -27,11 +27,12 @@ fn main() {
         .filter_map(Aabb::around)
         .reduce(|a, b| a.union(&b))
         .expect("the checkpoint holds particles");
-    let grid = UniformGrid::covering(bounds.min, bounds.max, h);
+    let grid = UniformGrid::covering(bounds.min, bounds.max, h).expect("memory for the grid");
     // The points in the grid's order, with the table of their cells.
     let sorted = |points: &[projfluid::Vec3], table: &mut CellTable| {
         let mut order = Vec::new();
-        grid.sort(points, &mut order, table);
+        grid.sort(points, &mut order, table)
+            .expect("memory for the sort");
         order
             .iter()
             .map(|&i| points[i as usize])
@@ -57,9 +58,11 @@ fn main() {
         for round in 0..3 {
             let among_fluid = time(&mut || {
                 grid.search(&fluid_table, &fluid, &fluid, h, true, &mut fluid_lists)
+                    .expect("memory for the lists")
             });
             let among_boundary = time(&mut || {
                 grid.search(&boundary_table, &boundary, &fluid, h, false, &mut boundary_lists)
+                    .expect("memory for the lists")
             });
             println!(
                 "round {round}: fluid {among_fluid:.3} ms ({} pairs), boundary {among_boundary:.3} ms ({} pairs)",

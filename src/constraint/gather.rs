@@ -2,9 +2,11 @@
 //! step made to it, from the λ_i of single-step projections and the kept segments of the
 //! others ([`Corrections`]), gathered from the particle's side (docs/method.md §2.5, §6).
 
-use super::stencil::{ordered_dot, pad_each};
+use super::stencil::{ordered_dot, pad_each, padded_room};
 use super::{DensityConstraint, Neighborhood, Projection};
 use crate::Vec3;
+use crate::reserve::reserve_total;
+use std::collections::TryReserveError;
 
 /// The stencil corrections P_{i,j} − x_j (m) of the multi-step projections of one local step,
 /// and of those only: constraint i's segment holds its own correction and then one per fluid
@@ -27,6 +29,9 @@ pub struct Corrections {
     /// Whether particle j is a member of a stencil whose projection kept a segment: only
     /// then does its gather look for segments.
     pub(super) near_kept: Vec<bool>,
+    /// Tests refuse segments of more entries than this, as a shortage of memory would.
+    #[cfg(test)]
+    pub(crate) segment_limit: Option<usize>,
 }
 
 impl Corrections {
@@ -79,6 +84,22 @@ struct Gather {
 }
 
 impl Gather {
+    /// Reserves room for particles of up to `n` neighbours, as [`Gather::resize`] grows the
+    /// arrays for them, so that it then allocates nothing.
+    fn try_reserve(&mut self, n: usize) -> Result<(), TryReserveError> {
+        reserve_total(&mut self.ids, n)?;
+        for v in [
+            &mut self.lambdas,
+            &mut self.rx,
+            &mut self.ry,
+            &mut self.rz,
+            &mut self.factors,
+        ] {
+            reserve_total(v, padded_room(n))?;
+        }
+        Ok(())
+    }
+
     /// Room for `n` neighbours in every array.
     fn resize(&mut self, n: usize) {
         if self.ids.len() < n {
@@ -97,6 +118,11 @@ impl Gather {
 
 thread_local! {
     static GATHER: std::cell::RefCell<Gather> = std::cell::RefCell::new(Gather::default());
+}
+
+/// Reserves the calling thread's gather buffers for particles of up to `n` neighbours.
+pub(super) fn reserve_gather(n: usize) -> Result<(), TryReserveError> {
+    GATHER.with_borrow_mut(|gather| gather.try_reserve(n))
 }
 
 impl DensityConstraint {
@@ -152,9 +178,11 @@ impl DensityConstraint {
         let neighbors = nb.fluid.of(j);
         gather.resize(neighbors.len());
         let mut active = 0;
+        // Through a slice, so that its bounds stay in registers across the stores.
+        let ids = &mut gather.ids[..neighbors.len()];
         for &i in neighbors {
             // Written for every neighbour, kept only where the count moves on.
-            gather.ids[active] = i;
+            ids[active] = i;
             active += usize::from(corrections.moved[i as usize]);
         }
         let g = gather;

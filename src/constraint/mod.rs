@@ -19,6 +19,24 @@ use crate::Vec3;
 use crate::kernel::CubicKernel;
 use crate::neighbors::NeighborLists;
 use crate::params::ProjectionWeight;
+use std::collections::TryReserveError;
+
+/// Reserves, on every thread of `pool`, the buffers of the local step, the gather and the
+/// density evaluations for stencils of up to `fluid` fluid and `boundary` boundary members
+/// (the most neighbours any particle has in a step's lists), so that those per-thread
+/// buffers allocate nothing during the step. Errors when the memory cannot be had.
+pub(crate) fn reserve_scratch(
+    pool: &rayon::ThreadPool,
+    fluid: usize,
+    boundary: usize,
+) -> Result<(), TryReserveError> {
+    pool.broadcast(|_| {
+        stencil::SCRATCH.with_borrow_mut(|scratch| scratch.try_reserve(fluid, boundary))?;
+        gather::reserve_gather(fluid)
+    })
+    .into_iter()
+    .collect()
+}
 
 /// The default [`DensityConstraint::membership_floor`]: particles with fewer than 15 fluid
 /// neighbours (spray, thin sheets) are counted in 16 stencils by the global step. Measured on
@@ -134,18 +152,19 @@ mod test_cluster {
             .flat_map(|i| (-4..18).map(move |k| Vec3::new(i as f64 * b, 0.0, k as f64 * b)))
             .collect();
         let psi = vec![constraint.mass / 8.0; boundary.len()];
-        let grid = UniformGrid::covering(Vec3::repeat(-1.0), Vec3::repeat(2.0), h);
+        let grid = UniformGrid::covering(Vec3::repeat(-1.0), Vec3::repeat(2.0), h).unwrap();
         let sorted = |points: &[Vec3]| {
             let (mut order, mut table) = (Vec::new(), CellTable::default());
-            grid.sort(points, &mut order, &mut table);
+            grid.sort(points, &mut order, &mut table).unwrap();
             let p: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
             (p, table)
         };
         let (x, fluid_table) = sorted(&fluid);
         let (bx, boundary_table) = sorted(&boundary);
         let (mut fl, mut bl) = (NeighborLists::default(), NeighborLists::default());
-        grid.search(&fluid_table, &x, &x, h, true, &mut fl);
-        grid.search(&boundary_table, &bx, &x, h, false, &mut bl);
+        grid.search(&fluid_table, &x, &x, h, true, &mut fl).unwrap();
+        grid.search(&boundary_table, &bx, &x, h, false, &mut bl)
+            .unwrap();
         let mut weights = Vec::new();
         constraint.weights(&fl, &mut weights);
         Cluster {

@@ -8,7 +8,9 @@ use super::{
 };
 use crate::Vec3;
 use crate::neighbors::par_segments_zip_mut;
+use crate::reserve::reserve_total;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// What the local step of one constraint produced.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -34,18 +36,26 @@ impl DensityConstraint {
     /// P_{i,j} − x_j (m) into `corrections`: once all constraints are projected, the few
     /// multi-step ones are projected again into segments sized for them alone (a projection
     /// is a pure function of `x`, so the second pass repeats the first bit for bit).
+    ///
+    /// Errors when memory for the projections or the kept segments cannot be had; the
+    /// projections and corrections are then incomplete (a step that fails is undone). The
+    /// per-thread buffers grow as a stencil needs, within the room a time step reserves for
+    /// its largest stencil before it projects.
     pub fn project(
         &self,
         x: &[Vec3],
         nb: &Neighborhood,
         projections: &mut Vec<Projection>,
         corrections: &mut Corrections,
-    ) {
+    ) -> Result<(), TryReserveError> {
         let c = corrections;
+        reserve_total(projections, x.len())?;
+        reserve_total(&mut c.lambdas, x.len())?;
+        reserve_total(&mut c.moved, x.len())?;
         projections.resize(x.len(), Projection::default());
         c.lambdas.resize(x.len(), 0.0);
         c.moved.resize(x.len(), 0);
-        let any_kept = projections
+        let kept = projections
             .par_chunks_mut(CHUNK)
             .zip(c.lambdas.par_chunks_mut(CHUNK))
             .zip(c.moved.par_chunks_mut(CHUNK))
@@ -54,7 +64,7 @@ impl DensityConstraint {
                 SCRATCH.with_borrow_mut(|scratch| {
                     // Corrections written here are dropped; the buffer only grows.
                     let mut dp = std::mem::take(&mut scratch.dp);
-                    let mut kept = false;
+                    let mut kept = 0;
                     for (k, ((out, lambda), moved)) in
                         outs.iter_mut().zip(lambdas).zip(moved).enumerate()
                     {
@@ -66,23 +76,25 @@ impl DensityConstraint {
                         self.project_one(i, x, nb, &mut dp[..members], out, scratch);
                         *lambda = if out.materialized { 0.0 } else { out.lambda };
                         *moved = u8::from(*lambda != 0.0);
-                        kept |= out.materialized;
+                        kept += usize::from(out.materialized);
                     }
                     scratch.dp = dp;
                     kept
                 })
             })
-            .reduce(|| false, |a, b| a || b);
+            .sum::<usize>();
 
         // The flags were set only if the last local step kept a segment (rarely); only then
         // are they cleared.
         let flags_set = !c.owners.is_empty();
+        reserve_total(&mut c.owners, kept)?;
+        reserve_total(&mut c.near_kept, projections.len())?;
+        reserve_total(&mut c.offsets, kept + 1)?;
         c.owners.clear();
-        if any_kept {
-            c.owners.par_extend(
-                (0..projections.len() as u32)
-                    .into_par_iter()
-                    .filter(|&i| projections[i as usize].materialized),
+        if kept > 0 {
+            // In one pass over the flags, within the room just made.
+            c.owners.extend(
+                (0..projections.len() as u32).filter(|&i| projections[i as usize].materialized),
             );
         }
         if c.near_kept.len() != projections.len() || flags_set {
@@ -103,14 +115,22 @@ impl DensityConstraint {
                 .push(start + nb.fluid.count(i as usize) as u32 + 1);
         }
         c.data.clear();
-        c.data
-            .resize(*c.offsets.last().unwrap_or(&0) as usize, Vec3::zeros());
+        let segments = *c.offsets.last().unwrap_or(&0) as usize;
+        // The segments of a strongly compressed fluid can be as large as the neighbour
+        // lists, and six times their bytes.
+        #[cfg(test)]
+        if c.segment_limit.is_some_and(|limit| segments > limit) {
+            return Err(Vec::<Vec3>::new().try_reserve(usize::MAX).unwrap_err());
+        }
+        reserve_total(&mut c.data, segments)?;
+        c.data.resize(segments, Vec3::zeros());
         par_segments_zip_mut(&c.offsets, &mut c.data, &mut c.owners, |_, dp, &mut i| {
             let mut again = Projection::default();
             SCRATCH.with_borrow_mut(|scratch| {
                 self.project_one(i as usize, x, nb, dp, &mut again, scratch)
             });
         });
+        Ok(())
     }
 
     /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary

@@ -3,7 +3,9 @@
 //! one fixed order.
 
 use crate::Vec3;
+use crate::reserve::reserve_total;
 use std::cell::RefCell;
+use std::collections::TryReserveError;
 
 /// A stencil's members are kept in arrays padded to a multiple of this many entries, so
 /// that every loop over them runs in whole vectors of four lanes with no remainder.
@@ -28,6 +30,46 @@ pub(super) struct Scratch {
 
 thread_local! {
     pub(super) static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl Scratch {
+    /// Reserves room for stencils of up to `fluid` fluid and `boundary` boundary members,
+    /// as the projections, densities and filters grow the buffers for them (with the
+    /// padding of [`pad_each`]), so that they then allocate nothing.
+    pub(super) fn try_reserve(
+        &mut self,
+        fluid: usize,
+        boundary: usize,
+    ) -> Result<(), TryReserveError> {
+        reserve_total(&mut self.dp, fluid + 1)?;
+        reserve_total(&mut self.grads, fluid)?;
+        let m = &mut self.members;
+        for v in [
+            &mut m.rx,
+            &mut m.ry,
+            &mut m.rz,
+            &mut m.len,
+            &mut m.gx,
+            &mut m.gy,
+            &mut m.gz,
+            &mut m.weights,
+            &mut m.values,
+        ] {
+            reserve_total(v, padded_room(fluid))?;
+        }
+        let b = &mut self.boundary;
+        for v in [
+            &mut b.rx,
+            &mut b.ry,
+            &mut b.rz,
+            &mut b.len,
+            &mut b.psi,
+            &mut b.values,
+        ] {
+            reserve_total(v, padded_room(boundary))?;
+        }
+        Ok(())
+    }
 }
 
 /// The boundary members of one stencil by component, as [`Members`]: offsets r = x_i − x_b
@@ -61,13 +103,21 @@ impl BoundaryMembers {
     }
 }
 
+/// The entries [`pad_each`] grows an array to for `n` members: `n` and one whole vector.
+#[inline(always)]
+pub(super) fn padded_room(n: usize) -> usize {
+    n + LANES
+}
+
 /// `n` rounded up to a multiple of [`LANES`].
 #[inline(always)]
 pub(super) fn padded(n: usize) -> usize {
     n.next_multiple_of(LANES)
 }
 
-/// Grows the arrays of a structure of arrays to at least `n` + [`LANES`] entries (more than
+/// Grows the arrays of a structure of arrays to at least `n` + [`LANES`] entries (within the
+/// room [`Scratch::try_reserve`] and [`reserve_scratch`](super::reserve_scratch) make for a
+/// step's stencils) (more than
 /// [`padded`]`(n)`) and writes each `padding` array's value into its entries
 /// `n..n + LANES`, one whole vector, which covers the padding `n..padded(n)` (the
 /// `computed` arrays are written over the padded range before they are read). The arrays
@@ -78,7 +128,7 @@ pub(super) fn pad_each<const P: usize, const C: usize>(
     computed: [&mut Vec<f64>; C],
     n: usize,
 ) {
-    let room = n + LANES;
+    let room = padded_room(n);
     let grow = |v: &mut Vec<f64>| {
         if v.len() < room {
             v.resize(room, 0.0);

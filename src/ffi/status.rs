@@ -22,7 +22,8 @@ pub enum PfStatus {
     /// An output buffer was too short; the size needed was written to `*needed`.
     PF_ERROR_BUFFER_TOO_SMALL = 3,
     /// Memory could not be allocated: for particles, boundaries, meshes, or what the next
-    /// steps need (buffers and neighbour lists, reserved before the first step of a call).
+    /// steps need (buffers and neighbour lists reserved before the first step of a call, or
+    /// neighbour lists, grid and corrections that grow during a step).
     PF_ERROR_OUT_OF_MEMORY = 4,
     /// The library panicked (a bug); the world involved, if any, is now poisoned.
     PF_ERROR_PANIC = 5,

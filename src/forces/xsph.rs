@@ -26,6 +26,10 @@ impl Xsph {
 }
 
 impl NonPressureForce for Xsph {
+    fn try_reserve(&mut self, particles: usize) -> Result<(), std::collections::TryReserveError> {
+        crate::reserve::reserve_total(&mut self.volumes, particles)
+    }
+
     fn apply(
         &mut self,
         constraint: &DensityConstraint,

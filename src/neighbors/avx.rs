@@ -6,6 +6,7 @@
 use super::PointsByComponent;
 use super::search::Block;
 use crate::Vec3;
+use std::collections::TryReserveError;
 
 impl Block<'_> {
     crate::simd::avx2_dispatch! {
@@ -15,7 +16,7 @@ impl Block<'_> {
             queries: &[Vec3],
             starts: &mut Vec<u32>,
             found: &mut Vec<u32>,
-        ) where true => search_portable
+        ) -> Result<(), TryReserveError> where true => search_portable
     }
 
     /// The AVX-512 build of [`Block::search`]. A point set searched among itself (a
@@ -31,7 +32,7 @@ impl Block<'_> {
         queries: &[Vec3],
         starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
-    ) {
+    ) -> Result<(), TryReserveError> {
         // SAFETY: as this function's.
         unsafe {
             if self.exclude_self.is_some() {
@@ -54,7 +55,7 @@ impl Block<'_> {
         queries: &[Vec3],
         starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
-    ) {
+    ) -> Result<(), TryReserveError> {
         self.search_with::<true, SPARSE>(queries, starts, found)
     }
 }
@@ -62,16 +63,18 @@ impl Block<'_> {
 /// [`push_within_portable`] for the points of `ranges` of `points` (ascending and
 /// disjoint), tested where they lie, eight at a time: the same operations in the same
 /// order (so the same tests, bit for bit) into a mask, and the indices that pass
-/// compressed to the front of a vector that is stored whole at the end of `found` (room for
-/// one more vector is reserved; the entries past the indices kept are overwritten by the
-/// next store or left beyond the length). Point `own` is left out. With `SPARSE` the masks
+/// compressed to the front of a vector that is stored whole at the end of `found` (which
+/// has room for every point of the ranges and one vector more, made by the caller so that
+/// it can fail; the entries past the indices kept are overwritten by the next store or
+/// left beyond the length). Point `own` is left out. With `SPARSE` the masks
 /// of four batches are formed first and a group of 32 points none of which passes is
 /// skipped: worth its branch where few candidates pass (about one in sixty of the
 /// boundary's), not where one in seven does (the fluid's); see [`Block::search_avx512`].
 ///
 /// # Safety
 /// The processor must support what [`crate::simd::has_avx512`] checks; the ranges lie
-/// within `points`, whose indices fit in `u32`.
+/// within `points`, whose indices fit in `u32`; `found` has spare capacity for the points
+/// of the ranges and eight more.
 ///
 /// [`push_within_portable`]: super::search::push_within_portable
 #[cfg(target_arch = "x86_64")]
@@ -89,7 +92,11 @@ pub(super) unsafe fn push_within_avx512<const SPARSE: bool>(
     const WIDTH: usize = 8;
     let total: usize = ranges.iter().map(|r| r.len()).sum();
     debug_assert!(ranges.iter().all(|r| r.end <= points.x.len()));
-    found.reserve(total + WIDTH);
+    // A check, not a reservation (the caller reserved): the stores below rely on the room.
+    assert!(
+        found.capacity() - found.len() >= total + WIDTH,
+        "no room for the neighbours"
+    );
     let mut len = found.len();
     let out = found.as_mut_ptr();
     let (qx, qy, qz) = (
@@ -172,11 +179,11 @@ mod tests {
                 .into_iter()
                 .map(|p| p + Vec3::repeat(0.31)),
         );
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius).unwrap();
         let mut table = CellTable::default();
         let sorted = sorted_copy(&grid, &pts, &mut table);
         let mut points = PointsByComponent::default();
-        points.fill(&sorted);
+        points.fill(&sorted).unwrap();
         for exclude_self in [None, Some(0)] {
             let block = Block {
                 grid: &grid,
@@ -190,18 +197,19 @@ mod tests {
                 build(&mut starts, &mut found);
                 (starts, found)
             };
-            let reference = run(&|c, f| block.search_portable(&sorted, c, f));
+            let reference = run(&|c, f| block.search_portable(&sorted, c, f).unwrap());
             assert!(reference.1.len() > 20_000, "{} pairs", reference.1.len());
             #[cfg(target_arch = "x86_64")]
             {
                 if std::arch::is_x86_feature_detected!("avx2") {
                     // SAFETY: the processor has AVX2.
-                    let avx2 = run(&|c, f| unsafe { block.search_avx2(&sorted, c, f) });
+                    let avx2 = run(&|c, f| unsafe { block.search_avx2(&sorted, c, f).unwrap() });
                     assert_eq!(avx2, reference, "AVX2 build");
                 }
                 if crate::simd::has_avx512() {
                     // SAFETY: the processor has the AVX-512 subsets.
-                    let avx512 = run(&|c, f| unsafe { block.search_avx512(&sorted, c, f) });
+                    let avx512 =
+                        run(&|c, f| unsafe { block.search_avx512(&sorted, c, f).unwrap() });
                     assert_eq!(avx512, reference, "AVX-512 build");
                 }
             }

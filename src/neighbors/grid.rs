@@ -2,7 +2,9 @@
 //! of points by cell into a [`CellTable`] (docs/method.md §6).
 
 use crate::Vec3;
+use crate::reserve::reserve_total;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// Largest number of cells a grid may have; beyond it the grid stops growing and particles
 /// outside are clamped into its border cells (still correct, only slower).
@@ -22,7 +24,9 @@ pub struct UniformGrid {
 impl UniformGrid {
     /// A grid of cells of edge `cell_size` (metres) covering `[min, max]` plus one cell of margin
     /// on every side. The cell count is capped; an oversized domain gets a clamped grid.
-    pub fn covering(min: Vec3, max: Vec3, cell_size: f64) -> Self {
+    /// Errors when memory for the grid's table of cell ranks (4 bytes a cell, and 16 a cell
+    /// while it is built) cannot be had.
+    pub fn covering(min: Vec3, max: Vec3, cell_size: f64) -> Result<Self, TryReserveError> {
         let origin = min - Vec3::repeat(cell_size);
         let mut dims = [0usize; 3];
         for axis in 0..3 {
@@ -38,12 +42,13 @@ impl UniformGrid {
 
     /// The grid with lower corner `origin` (m), cells of edge `cell_size` (m) and `dims`
     /// cells per axis (each at least 1, product at most the cell limit), e.g. as returned by
-    /// [`UniformGrid::parts`]; `None` for parts no grid has.
+    /// [`UniformGrid::parts`]; `None` for parts no grid has, `Some(Err)` when memory for it
+    /// cannot be had.
     pub(crate) fn from_parts_checked(
         origin: Vec3,
         cell_size: f64,
         dims: [usize; 3],
-    ) -> Option<Self> {
+    ) -> Option<Result<Self, TryReserveError>> {
         let valid = origin.iter().all(|c| c.is_finite())
             && cell_size.is_finite()
             && cell_size > 0.0
@@ -58,27 +63,29 @@ impl UniformGrid {
         (self.origin, self.cell_size, self.dims)
     }
 
-    fn from_parts(origin: Vec3, cell_size: f64, dims: [usize; 3]) -> Self {
+    fn from_parts(origin: Vec3, cell_size: f64, dims: [usize; 3]) -> Result<Self, TryReserveError> {
         let count = dims.iter().product::<usize>();
-        let mut by_morton: Vec<(u64, u32)> = (0..count)
-            .map(|linear| {
-                let x = linear % dims[0];
-                let y = (linear / dims[0]) % dims[1];
-                let z = linear / (dims[0] * dims[1]);
-                (morton_code(x as u32, y as u32, z as u32), linear as u32)
-            })
-            .collect();
+        let mut by_morton: Vec<(u64, u32)> = Vec::new();
+        by_morton.try_reserve_exact(count)?;
+        by_morton.extend((0..count).map(|linear| {
+            let x = linear % dims[0];
+            let y = (linear / dims[0]) % dims[1];
+            let z = linear / (dims[0] * dims[1]);
+            (morton_code(x as u32, y as u32, z as u32), linear as u32)
+        }));
         by_morton.sort_unstable();
-        let mut z_rank = vec![0u32; count];
+        let mut z_rank = Vec::new();
+        z_rank.try_reserve_exact(count)?;
+        z_rank.resize(count, 0u32);
         for (rank, &(_, linear)) in by_morton.iter().enumerate() {
             z_rank[linear as usize] = rank as u32;
         }
-        Self {
+        Ok(Self {
             origin,
             cell_size,
             dims,
             z_rank,
-        }
+        })
     }
 
     /// Number of cells.
@@ -125,8 +132,17 @@ impl UniformGrid {
 
     /// Counting sort of `points` by cell in Z-order. Writes `order` (sorted slot → input index,
     /// stable) and the table of cell ranges. Returns whether every point lies inside the
-    /// grid's domain ([`UniformGrid::covers`]), from the same pass.
-    pub fn sort(&self, points: &[Vec3], order: &mut Vec<u32>, table: &mut CellTable) -> bool {
+    /// grid's domain ([`UniformGrid::covers`]), from the same pass; or, changing nothing,
+    /// an error when memory for `order` and the table (4 bytes a point twice, 4 a cell)
+    /// cannot be had.
+    pub fn sort(
+        &self,
+        points: &[Vec3],
+        order: &mut Vec<u32>,
+        table: &mut CellTable,
+    ) -> Result<bool, TryReserveError> {
+        table.try_reserve(points.len(), self.cell_count())?;
+        reserve_total(order, points.len())?;
         let ranks = &mut table.ranks;
         ranks.resize(points.len(), 0);
         let domain = self.domain();
@@ -158,7 +174,7 @@ impl UniformGrid {
         }
         starts.copy_within(..self.cell_count(), 1);
         starts[0] = 0;
-        covered
+        Ok(covered)
     }
 }
 
@@ -177,17 +193,28 @@ impl CellTable {
         self.cell_start.last().map_or(0, |&n| n as usize)
     }
 
-    /// Reserves the sort's scratch for `points` points.
+    /// Reserves the sort's scratch for `points` points and the ranges of `cells` cells.
     pub(crate) fn try_reserve(
         &mut self,
         points: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
-        crate::reserve::reserve_total(&mut self.ranks, points)
+        cells: usize,
+    ) -> Result<(), TryReserveError> {
+        reserve_total(&mut self.ranks, points)?;
+        reserve_total(&mut self.cell_start, cells.saturating_add(1))
     }
 
     /// Frees the sort's scratch, for a table that is sorted once and kept (the boundary's).
     pub(crate) fn release_scratch(&mut self) {
         self.ranks = Vec::new();
+    }
+
+    /// Makes this table a copy of `other`'s cell ranges (not of its scratch), reusing this
+    /// one's storage; errors when memory for them cannot be had (the table is then empty).
+    pub(crate) fn try_copy_from(&mut self, other: &CellTable) -> Result<(), TryReserveError> {
+        self.cell_start.clear();
+        reserve_total(&mut self.cell_start, other.cell_start.len())?;
+        self.cell_start.extend_from_slice(&other.cell_start);
+        Ok(())
     }
 }
 
@@ -228,10 +255,10 @@ mod tests {
     #[test]
     fn sort_is_a_stable_permutation_in_z_order() {
         let pts = random_points(3000, 7, 1.0);
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1).unwrap();
         let mut table = CellTable::default();
         let mut order = Vec::new();
-        grid.sort(&pts, &mut order, &mut table);
+        grid.sort(&pts, &mut order, &mut table).unwrap();
         let mut seen = order.clone();
         seen.sort_unstable();
         assert!(seen.iter().enumerate().all(|(i, &v)| i as u32 == v));

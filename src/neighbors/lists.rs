@@ -3,7 +3,9 @@
 
 use super::BLOCK;
 use crate::Vec3;
+use crate::reserve::reserve_total;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// Neighbour lists in compressed form, kept where the search wrote them: the queries are
 /// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`, each list
@@ -61,15 +63,31 @@ impl NeighborLists {
         self.blocks.iter().map(|(_, found)| found.len()).sum()
     }
 
+    /// The largest number of neighbours of any query (0 without queries).
+    pub fn most(&self) -> usize {
+        let blocks = &self.blocks[..self.queries.div_ceil(BLOCK)];
+        blocks
+            .par_iter()
+            .map(|(starts, _)| starts.windows(2).map(|w| w[1] - w[0]).max().unwrap_or(0))
+            .max()
+            .unwrap_or(0) as usize
+    }
+
+    /// Frees the lists and their reservation, e.g. after a search that ran out of memory
+    /// part-way, so that what it grew is given back.
+    pub(crate) fn release(&mut self) {
+        self.queries = 0;
+        self.blocks = Vec::new();
+    }
+
     /// Reserves room for a search of `queries` points finding about `per_query` neighbours
     /// each (more where a block found more last time), so that such a search allocates
-    /// nothing. The lists found so far stay as they are.
+    /// nothing unless some queries find more. The lists found so far stay as they are.
     pub(crate) fn try_reserve(
         &mut self,
         queries: usize,
         per_query: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
-        use crate::reserve::reserve_total;
+    ) -> Result<(), TryReserveError> {
         let blocks = queries.div_ceil(BLOCK);
         reserve_total(&mut self.blocks, blocks)?;
         while self.blocks.len() < blocks {
@@ -124,22 +142,27 @@ pub struct PointsByComponent {
 }
 
 impl PointsByComponent {
-    /// Replaces the contents with the points of `ranges` of `points`, in that order.
+    /// Replaces the contents with the points of `ranges` of `points` (`total` in all), in
+    /// that order; errors when memory for them cannot be had (the contents are then
+    /// unspecified).
     pub(super) fn copy_ranges(
         &mut self,
         points: &PointsByComponent,
         ranges: &[std::ops::Range<usize>],
-    ) {
+        total: usize,
+    ) -> Result<(), TryReserveError> {
         for (out, from) in [
             (&mut self.x, &points.x),
             (&mut self.y, &points.y),
             (&mut self.z, &points.z),
         ] {
             out.clear();
+            reserve_total(out, total)?;
             for range in ranges {
                 out.extend_from_slice(&from[range.clone()]);
             }
         }
+        Ok(())
     }
 
     /// Point `i` (m).
@@ -158,24 +181,42 @@ impl PointsByComponent {
         self.x.is_empty()
     }
 
-    /// Reserves room for `points` points in all.
-    pub(crate) fn try_reserve(
+    /// Makes these points a copy of `other`, reusing this one's storage; errors when memory
+    /// for them cannot be had (the contents are then unspecified).
+    pub(crate) fn try_copy_from(
         &mut self,
-        points: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
-        for c in [&mut self.x, &mut self.y, &mut self.z] {
-            crate::reserve::reserve_total(c, points)?;
+        other: &PointsByComponent,
+    ) -> Result<(), TryReserveError> {
+        for (out, from) in [
+            (&mut self.x, &other.x),
+            (&mut self.y, &other.y),
+            (&mut self.z, &other.z),
+        ] {
+            out.clear();
+            reserve_total(out, from.len())?;
+            out.extend_from_slice(from);
         }
         Ok(())
     }
 
-    /// Replaces the contents with `points` (m), in one parallel pass.
-    pub fn fill(&mut self, points: &[Vec3]) {
+    /// Reserves room for `points` points in all.
+    pub(crate) fn try_reserve(&mut self, points: usize) -> Result<(), TryReserveError> {
+        for c in [&mut self.x, &mut self.y, &mut self.z] {
+            reserve_total(c, points)?;
+        }
+        Ok(())
+    }
+
+    /// Replaces the contents with `points` (m), in one parallel pass; or, changing nothing,
+    /// errors when memory for them (24 bytes a point) cannot be had.
+    pub fn fill(&mut self, points: &[Vec3]) -> Result<(), TryReserveError> {
+        self.try_reserve(points.len())?;
         for out in [&mut self.x, &mut self.y, &mut self.z] {
             out.resize(points.len(), 0.0);
         }
         (&mut self.x[..], &mut self.y[..], &mut self.z[..], points)
             .into_par_iter()
             .for_each(|(x, y, z, p)| (*x, *y, *z) = (p.x, p.y, p.z));
+        Ok(())
     }
 }

@@ -36,7 +36,7 @@ mod test_points {
         table: &mut CellTable,
     ) -> Vec<Vec3> {
         let mut order = Vec::new();
-        grid.sort(pts, &mut order, table);
+        grid.sort(pts, &mut order, table).unwrap();
         order.iter().map(|&i| pts[i as usize]).collect()
     }
 }

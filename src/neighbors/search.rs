@@ -6,11 +6,21 @@
 use super::avx::push_within_avx512;
 use super::{BLOCK, CellTable, NeighborLists, PointsByComponent, UniformGrid};
 use crate::Vec3;
+use crate::reserve::reserve_total;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
+
+/// Room for one more vector of indices past a query's candidates, which the AVX-512 build
+/// stores whole ([`push_within_avx512`]).
+const STORE_SLACK: usize = 8;
 
 impl UniformGrid {
     /// For every query point, the indices of `points` (already in the order of `table`) within
     /// `radius` (≤ cell size), sorted ascending. With `exclude_self`, query i skips point i.
+    ///
+    /// The lists reuse the storage `out` had and grow, through fallible reservations, where
+    /// it is short: when memory runs out the search stops with the error, and `out` then
+    /// answers for no query until it is searched again.
     pub fn search(
         &self,
         table: &CellTable,
@@ -19,11 +29,13 @@ impl UniformGrid {
         radius: f64,
         exclude_self: bool,
         out: &mut NeighborLists,
-    ) {
+    ) -> Result<(), TryReserveError> {
         let mut coordinates = std::mem::take(&mut out.coordinates);
-        coordinates.fill(points);
-        self.search_in(table, &coordinates, queries, radius, exclude_self, out);
+        let searched = coordinates
+            .fill(points)
+            .and_then(|()| self.search_in(table, &coordinates, queries, radius, exclude_self, out));
         out.coordinates = coordinates;
+        searched
     }
 
     /// [`UniformGrid::search`] among `points` already copied by component (for points that
@@ -40,9 +52,9 @@ impl UniformGrid {
         radius: f64,
         exclude_self: bool,
         out: &mut NeighborLists,
-    ) {
+    ) -> Result<(), TryReserveError> {
         let first = exclude_self.then_some(0);
-        self.search_from(table, points, queries, first, radius, out);
+        self.search_from(table, points, queries, first, radius, out)
     }
 
     /// [`UniformGrid::search_in`] for a run of the points themselves: with `Some(first)` the
@@ -57,7 +69,7 @@ impl UniformGrid {
         first_self: Option<usize>,
         radius: f64,
         out: &mut NeighborLists,
-    ) {
+    ) -> Result<(), TryReserveError> {
         assert!(
             radius <= self.cell_size,
             "search radius exceeds the cell size"
@@ -69,11 +81,16 @@ impl UniformGrid {
         );
         let r2 = radius * radius;
         let blocks = queries.len().div_ceil(BLOCK);
+        // Until the blocks are searched the lists answer for no query.
+        out.queries = 0;
+        reserve_total(&mut out.blocks, blocks)?;
         out.blocks.resize_with(blocks, Default::default);
+        // Each block grows only its own lists, so what they hold does not depend on the
+        // thread count; a block that runs out of memory fails the whole search.
         out.blocks
             .par_iter_mut()
             .enumerate()
-            .for_each(|(b, (starts, found))| {
+            .try_for_each(|(b, (starts, found))| {
                 let first = b * BLOCK;
                 let queries = &queries[first..(first + BLOCK).min(queries.len())];
                 let block = Block {
@@ -83,9 +100,10 @@ impl UniformGrid {
                     r2,
                     exclude_self: first_self.map(|own| own + first),
                 };
-                block.search(queries, starts, found);
-            });
+                block.search(queries, starts, found)
+            })?;
         out.queries = queries.len();
+        Ok(())
     }
 }
 
@@ -104,8 +122,14 @@ impl Block<'_> {
     /// Replaces `found` with the neighbours of every query, one list after another, and
     /// `starts` with where each list starts there (and, last, where the last one ends): eight
     /// distance tests per instruction in the AVX-512 build, four in the AVX2 build, the same
-    /// lists from every build (tested).
-    fn search(&self, queries: &[Vec3], starts: &mut Vec<u32>, found: &mut Vec<u32>) {
+    /// lists from every build (tested). Errors when the lists need more memory than can be
+    /// had.
+    fn search(
+        &self,
+        queries: &[Vec3],
+        starts: &mut Vec<u32>,
+        found: &mut Vec<u32>,
+    ) -> Result<(), TryReserveError> {
         #[cfg(target_arch = "x86_64")]
         if crate::simd::has_avx512() {
             // SAFETY: the processor supports the build's features, checked just above.
@@ -122,7 +146,7 @@ impl Block<'_> {
         queries: &[Vec3],
         starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
-    ) {
+    ) -> Result<(), TryReserveError> {
         self.search_with::<false, false>(queries, starts, found)
     }
 
@@ -131,16 +155,22 @@ impl Block<'_> {
     /// and the neighbours found are compressed into `found` a vector at a time, skipping
     /// candidates by groups with `SPARSE` ([`push_within_avx512`]); without, they are first
     /// copied into one run.
+    ///
+    /// A query finds at most its candidates, the points of its cell and the adjacent ones;
+    /// room for that many (and one vector more) is made before each query, fallibly, so
+    /// that the pushes never reallocate. Where the lists had room, that is one comparison
+    /// per query.
     #[inline(always)]
     pub(super) fn search_with<const AVX512: bool, const SPARSE: bool>(
         &self,
         queries: &[Vec3],
         starts: &mut Vec<u32>,
         found: &mut Vec<u32>,
-    ) {
+    ) -> Result<(), TryReserveError> {
         let grid = self.grid;
         let p = self.points;
         starts.clear();
+        reserve_total(starts, queries.len() + 1)?;
         starts.push(0);
         found.clear();
         // The points of the previous query's cell and its neighbour cells, in ascending
@@ -149,62 +179,90 @@ impl Block<'_> {
         // every query of the cell tests in long loops.
         let mut cached: Option<[usize; 3]> = None;
         let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
+        // The number of points in `ranges`.
+        let mut total = 0;
         // The thread's buffers for that run, kept from block to block (they only grow;
         // the AVX-512 build, which tests the ranges in place, leaves them empty).
         let (mut candidates, mut ids) = CANDIDATES.take();
-        for (k, q) in queries.iter().enumerate() {
-            let c = grid.cell_of(q);
-            if cached != Some(c) {
-                cached = Some(c);
-                ranges.clear();
-                for z in c[2].saturating_sub(1)..=(c[2] + 1).min(grid.dims[2] - 1) {
-                    for y in c[1].saturating_sub(1)..=(c[1] + 1).min(grid.dims[1] - 1) {
-                        for x in c[0].saturating_sub(1)..=(c[0] + 1).min(grid.dims[0] - 1) {
-                            let rank = grid.rank([x, y, z]);
-                            let cells = &self.table.cell_start;
-                            let (start, end) = (cells[rank] as usize, cells[rank + 1] as usize);
-                            // Empty cells are left out (most cells of the boundary's table).
-                            if start < end {
-                                ranges.push(start..end);
+        // A plain loop rather than an iterator's closure, which would be compiled apart from
+        // (and without the instruction sets of) the builds that inline this body.
+        let searched = 'search: {
+            for (k, q) in queries.iter().enumerate() {
+                let c = grid.cell_of(q);
+                if cached != Some(c) {
+                    cached = Some(c);
+                    ranges.clear();
+                    for z in c[2].saturating_sub(1)..=(c[2] + 1).min(grid.dims[2] - 1) {
+                        for y in c[1].saturating_sub(1)..=(c[1] + 1).min(grid.dims[1] - 1) {
+                            for x in c[0].saturating_sub(1)..=(c[0] + 1).min(grid.dims[0] - 1) {
+                                let rank = grid.rank([x, y, z]);
+                                let cells = &self.table.cell_start;
+                                let (start, end) = (cells[rank] as usize, cells[rank + 1] as usize);
+                                // Empty cells are left out (most cells of the boundary's table).
+                                if start < end {
+                                    ranges.push(start..end);
+                                }
                             }
                         }
                     }
-                }
-                ranges.sort_unstable_by_key(|r| r.start);
-                if AVX512 {
-                    // Tested where they lie: cells adjacent in Z-order make one run.
-                    ranges.dedup_by(|next, run| {
-                        let adjacent = run.end == next.start;
-                        if adjacent {
-                            run.end = next.end;
+                    ranges.sort_unstable_by_key(|r| r.start);
+                    total = ranges.iter().map(|r| r.len()).sum();
+                    if AVX512 {
+                        // Tested where they lie: cells adjacent in Z-order make one run.
+                        ranges.dedup_by(|next, run| {
+                            let adjacent = run.end == next.start;
+                            if adjacent {
+                                run.end = next.end;
+                            }
+                            adjacent
+                        });
+                    } else {
+                        if let Err(e) = candidates.copy_ranges(p, &ranges, total) {
+                            break 'search Err(e);
                         }
-                        adjacent
-                    });
-                } else {
-                    candidates.copy_ranges(p, &ranges);
-                    ids.clear();
-                    for r in &ranges {
-                        ids.extend(r.start as u32..r.end as u32);
+                        ids.clear();
+                        if let Err(e) = reserve_total(&mut ids, total) {
+                            break 'search Err(e);
+                        }
+                        for r in &ranges {
+                            ids.extend(r.start as u32..r.end as u32);
+                        }
                     }
                 }
-            }
-            #[cfg(target_arch = "x86_64")]
-            if AVX512 {
-                let own = self.exclude_self.map(|first| first + k);
-                // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
-                // processor has AVX-512; the ranges lie within the table's points.
-                unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
+                if found.capacity() - found.len() < total + STORE_SLACK
+                    && let Err(e) = grow(found, total + STORE_SLACK)
+                {
+                    break 'search Err(e);
+                }
+                #[cfg(target_arch = "x86_64")]
+                if AVX512 {
+                    let own = self.exclude_self.map(|first| first + k);
+                    // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
+                    // processor has AVX-512; the ranges lie within the table's points, and
+                    // `found` has room for their `total` points and one vector more.
+                    unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
+                    starts.push(found.len() as u32);
+                    continue;
+                }
+                let own = self
+                    .exclude_self
+                    .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
+                push_within_portable(q, &candidates, &ids, own, self.r2, found);
                 starts.push(found.len() as u32);
-                continue;
             }
-            let own = self
-                .exclude_self
-                .and_then(|first| ids.binary_search(&((first + k) as u32)).ok());
-            push_within_portable(q, &candidates, &ids, own, self.r2, found);
-            starts.push(found.len() as u32);
-        }
+            Ok(())
+        };
         CANDIDATES.set((candidates, ids));
+        searched
     }
+}
+
+/// Makes room in `found` for `additional` more neighbours: out of the search's loop, which
+/// only compares the room left with what a query may need.
+#[cold]
+#[inline(never)]
+fn grow(found: &mut Vec<u32>, additional: usize) -> Result<(), TryReserveError> {
+    found.try_reserve(additional)
 }
 
 /// Appends to `found`, in order, the `ids` of the `candidates` within √`r2` (m) of `q`,
@@ -219,9 +277,14 @@ pub(super) fn push_within_portable(
     found: &mut Vec<u32>,
 ) {
     let cand = candidates;
+    // The caller made room for every candidate: the neighbours are written into it without
+    // a check of the capacity per neighbour.
+    let room = found.spare_capacity_mut();
+    assert!(room.len() >= ids.len(), "no room for the neighbours");
+    let mut kept = 0;
     for lo in (0..ids.len()).step_by(64) {
         // The distance tests of up to 64 points into the bits of a mask (they vectorise),
-        // then one push per set bit (no branch per candidate).
+        // then one store per set bit (no branch per candidate).
         let hi = (lo + 64).min(ids.len());
         let mut mask = 0u64;
         for (bit, ((x, y), z)) in cand.x[lo..hi]
@@ -237,10 +300,13 @@ pub(super) fn push_within_portable(
             mask &= !(1 << (own - lo));
         }
         while mask != 0 {
-            found.push(ids[lo + mask.trailing_zeros() as usize]);
+            room[kept].write(ids[lo + mask.trailing_zeros() as usize]);
+            kept += 1;
             mask &= mask - 1;
         }
     }
+    // SAFETY: the first `kept` entries past the length were written just above.
+    unsafe { found.set_len(found.len() + kept) };
 }
 
 thread_local! {
@@ -269,11 +335,12 @@ mod tests {
                 .into_iter()
                 .map(|p| p + Vec3::repeat(0.52)),
         );
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), radius).unwrap();
         let mut table = CellTable::default();
         let sorted = sorted_copy(&grid, &pts, &mut table);
         let mut lists = NeighborLists::default();
-        grid.search(&table, &sorted, &sorted, radius, true, &mut lists);
+        grid.search(&table, &sorted, &sorted, radius, true, &mut lists)
+            .unwrap();
         assert_eq!(lists.len(), sorted.len());
         let mut total = 0;
         for (i, p) in sorted.iter().enumerate() {
@@ -293,9 +360,10 @@ mod tests {
         let others = random_points(1500, 3, 1.0);
         let sorted_others = sorted_copy(&grid, &others, &mut table);
         let mut prepared = PointsByComponent::default();
-        prepared.fill(&sorted_others);
+        prepared.fill(&sorted_others).unwrap();
         for queries in [&sorted, &random_points(700, 8, 1.0)] {
-            grid.search_in(&table, &prepared, queries, radius, false, &mut lists);
+            grid.search_in(&table, &prepared, queries, radius, false, &mut lists)
+                .unwrap();
             assert_eq!(lists.len(), queries.len());
             for (i, p) in queries.iter().enumerate() {
                 let brute: Vec<u32> = (0..sorted_others.len() as u32)
@@ -311,11 +379,11 @@ mod tests {
     #[test]
     #[should_panic(expected = "not the points the table sorted")]
     fn search_rejects_points_of_another_table() {
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1).unwrap();
         let mut table = CellTable::default();
         let sorted = sorted_copy(&grid, &random_points(50, 1, 1.0), &mut table);
         let mut prepared = PointsByComponent::default();
-        prepared.fill(&sorted[..40]);
+        prepared.fill(&sorted[..40]).unwrap();
         grid.search_in(
             &table,
             &prepared,
@@ -323,13 +391,14 @@ mod tests {
             0.1,
             false,
             &mut NeighborLists::default(),
-        );
+        )
+        .unwrap();
     }
 
     #[test]
     fn results_do_not_depend_on_thread_count() {
         let pts = random_points(5000, 11, 1.0);
-        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1);
+        let grid = UniformGrid::covering(Vec3::zeros(), Vec3::repeat(1.0), 0.1).unwrap();
         let run = |threads| {
             let pool = rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
@@ -339,7 +408,8 @@ mod tests {
                 let mut table = CellTable::default();
                 let sorted = sorted_copy(&grid, &pts, &mut table);
                 let mut lists = NeighborLists::default();
-                grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists);
+                grid.search(&table, &sorted, &sorted, 0.1, true, &mut lists)
+                    .unwrap();
                 (0..lists.len())
                     .map(|i| lists.of(i).to_vec())
                     .collect::<Vec<_>>()

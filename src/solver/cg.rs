@@ -60,6 +60,13 @@ impl Cg {
 }
 
 impl GlobalSolver for Cg {
+    fn try_reserve(&mut self, unknowns: usize) -> Result<(), std::collections::TryReserveError> {
+        for buffer in [&mut self.residual, &mut self.direction, &mut self.product] {
+            crate::reserve::reserve_total(buffer, unknowns)?;
+        }
+        Ok(())
+    }
+
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
         let n = x.len();
         self.residual.resize(n, Vec3::zeros());

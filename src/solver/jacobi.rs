@@ -33,6 +33,14 @@ impl Jacobi {
 }
 
 impl GlobalSolver for Jacobi {
+    fn try_reserve(&mut self, unknowns: usize) -> Result<(), std::collections::TryReserveError> {
+        // The single sweep is fused into the step's pass and never solves here.
+        if self.single_diagonal_sweep() {
+            return Ok(());
+        }
+        crate::reserve::reserve_total(&mut self.residual, unknowns)
+    }
+
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
         self.residual.resize(x.len(), Vec3::zeros());
         let b_norm = if self.check_residual {

@@ -58,6 +58,12 @@ impl SystemMatrix for DiagonalSystem {
 
 /// A linear solver for A·x = b (three right-hand sides at once).
 pub trait GlobalSolver: Send + Sync {
+    /// Reserves the solver's buffers for systems of `unknowns` particles, so that the steps
+    /// of a run allocate none of them; errors when the memory cannot be had. The default
+    /// reserves nothing.
+    fn try_reserve(&mut self, _unknowns: usize) -> Result<(), std::collections::TryReserveError> {
+        Ok(())
+    }
     /// Called once per time step, after A changed and before the first solve.
     fn prepare(&mut self, _matrix: &dyn SystemMatrix) {}
     /// Solves A·x = b with `x` holding the warm start; returns the inner iterations used.

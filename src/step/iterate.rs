@@ -12,6 +12,7 @@ use crate::solver::{Chebyshev, GlobalSolver, Sweep};
 use crate::stats::StepTimings;
 use crate::{Vec3, reduce};
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 use std::time::Instant;
 
 /// The density rule also waits until the last outer iteration moved no particle farther
@@ -52,7 +53,13 @@ pub(super) struct Outcome {
 
 /// Iterates until the density rule, the displacement rule or the iteration limit stops; the
 /// result X^(k) is left in `b.current`. Adds the local and global times to `timings`.
-pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimings) -> Outcome {
+/// Errors when a local step needs more memory for its kept corrections than can be had
+/// (the caller undoes the step).
+pub(super) fn iterate(
+    it: Iteration,
+    b: &mut StepBuffers,
+    timings: &mut StepTimings,
+) -> Result<Outcome, TryReserveError> {
     let Iteration {
         params,
         constraint,
@@ -96,7 +103,7 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     }
     while outer < params.max_outer_iterations {
         let t = Instant::now();
-        constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections);
+        constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections)?;
         let t_local = t.elapsed().as_secs_f64();
         if outer >= params.min_outer_iterations
             && displacement < DENSITY_RULE_MOTION * params.displacement_tolerance
@@ -191,14 +198,14 @@ pub(super) fn iterate(it: Iteration, b: &mut StepBuffers, timings: &mut StepTimi
     if accelerate {
         chebyshev.finish_step(&b.displacements);
     }
-    Outcome {
+    Ok(Outcome {
         outer,
         inner,
         displacement,
         rho,
         converged,
         densities_known,
-    }
+    })
 }
 
 /// The fluid's average compression at the iterate of the last local step,

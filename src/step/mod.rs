@@ -4,14 +4,20 @@
 //! Chebyshev's extrapolation) until the displacement rule stops; [`finish`] updates the
 //! velocities, evaluates densities, applies the non-pressure forces and measures the step;
 //! [`next_step_size`] chooses the next Δt by the CFL rule (docs/method.md §8).
+//!
+//! A step that runs out of memory for what only it can size — neighbour lists beyond their
+//! reservation, a rebuilt grid, kept corrections — fails before it moves the fluid, and
+//! puts back what it changed until then ([`undo`]).
 
 mod couple;
 mod finish;
 mod iterate;
 mod search;
+mod undo;
 
 pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
+pub(crate) use undo::Undo;
 
 use crate::body::Body;
 use crate::boundary::{Aabb, Boundary};
@@ -23,6 +29,7 @@ use crate::params::Params;
 use crate::solver::{Chebyshev, DiagonalSystem, GlobalSolver};
 use crate::stats::{StepStats, StepTimings};
 use crate::{Vec3, reduce};
+use std::collections::TryReserveError;
 use std::time::Instant;
 
 /// Buffers reused by every step, so that a step allocates nothing once sizes are stable.
@@ -56,6 +63,11 @@ pub(crate) struct StepBuffers {
     coupling: Coupling,
     /// The fluid's load on each body and, last, on the walls.
     loads: Vec<Load>,
+    /// What the step changed before it could still fail.
+    pub(crate) undo: Undo,
+    /// The stencil sizes (fluid, boundary members) that every thread's buffers of the local
+    /// step have room for ([`crate::constraint::reserve_scratch`]).
+    scratch_room: (usize, usize),
 }
 
 /// Everything one time step reads and writes, borrowed from the world that owns it.
@@ -84,7 +96,10 @@ pub(crate) struct StepContext<'a> {
 
 /// Advances the fluid by one step of `dt` seconds (positive, finite, checked by the
 /// caller) and returns what the step did with the size the next step should take (s).
-pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
+/// Errors when the step needs more memory than can be had (for neighbour lists, a rebuilt
+/// grid, the boundary's sort, kept corrections), having changed nothing: the fluid moves
+/// only once the step can no longer fail, and the rest is put back.
+pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), TryReserveError> {
     let started = Instant::now();
     let StepContext {
         params,
@@ -104,17 +119,20 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
         inflow_speed,
     } = ctx;
     let gravity = Vec3::from(params.gravity);
+    buffers.undo.start(bodies, &buffers.displacements);
     advance_poses(bodies, containers, params.particle_radius, dt, time);
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
-    let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers);
     let mut timings = StepTimings::default();
-    let stats = pool.install(|| {
+    let couple = !bodies.is_empty();
+    let iterated = pool.install(|| {
+        let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers)?;
         if boundary.has_moving() {
-            boundary.place_moving(grid, moving_particles(bodies));
+            boundary.save(&mut buffers.undo.boundary)?;
+            boundary.place_moving(grid, moving_particles(bodies))?;
         }
-        search::reorder_and_search(grid, fluid, boundary, params.support_radius(), buffers);
+        search::search(grid, boundary, params.support_radius(), buffers)?;
+        reserve_scratch(pool, buffers)?;
         timings.neighbors = started.elapsed().as_secs_f64();
-        let couple = !bodies.is_empty();
         if couple {
             buffers.coupling.start(
                 constraint,
@@ -124,7 +142,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
                 bodies.len(),
             );
         }
-        let outcome = iterate::iterate(
+        iterate::iterate(
             iterate::Iteration {
                 params,
                 constraint,
@@ -136,7 +154,22 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
             },
             buffers,
             &mut timings,
-        );
+        )
+    });
+    let outcome = match iterated {
+        Ok(outcome) => outcome,
+        Err(e) => {
+            let displacements = &mut buffers.displacements;
+            buffers.undo.restore(grid, boundary, bodies, displacements);
+            buffers.release_lists();
+            return Err(e);
+        }
+    };
+    buffers.undo.discard();
+    let stats = pool.install(|| {
+        let t = Instant::now();
+        search::permute_fluid(fluid, buffers);
+        timings.neighbors += t.elapsed().as_secs_f64();
         if couple {
             let loads = &mut buffers.loads;
             let predicted = buffers.fluid_lists.searched_points();
@@ -165,7 +198,19 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
     });
     let speed = fastest_inflow(bodies, inflow_speed);
     let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, speed));
-    (stats, next_dt)
+    Ok((stats, next_dt))
+}
+
+/// Makes every thread's buffers of the local step, the gather and the densities room for
+/// the largest stencils of the step's lists, when they have less.
+fn reserve_scratch(pool: &rayon::ThreadPool, b: &mut StepBuffers) -> Result<(), TryReserveError> {
+    let most = (b.fluid_lists.most(), b.boundary_lists.most());
+    if most.0 > b.scratch_room.0 || most.1 > b.scratch_room.1 {
+        let room = (most.0.max(b.scratch_room.0), most.1.max(b.scratch_room.1));
+        crate::constraint::reserve_scratch(pool, room.0, room.1)?;
+        b.scratch_room = room;
+    }
+    Ok(())
 }
 
 /// A step of `dt` seconds without fluid particles (all removed, the emitters not yet due,

@@ -1,6 +1,8 @@
 //! The neighbour phase of a step (docs/method.md §1.3, §6): the inertial prediction, the
-//! grid that covers it, the Z-order sort of all per-particle arrays, and the fluid and
-//! boundary neighbour searches on s.
+//! grid that covers it, the Z-order sort of the prediction, and the fluid and boundary
+//! neighbour searches on s. The phase changes nothing of the world that a failed step
+//! could not put back ([`super::Undo`]): the fluid's own arrays are reordered only once the step
+//! can no longer fail ([`permute_fluid`]).
 
 use super::StepBuffers;
 use crate::Vec3;
@@ -10,20 +12,25 @@ use crate::kernel::CubicKernel;
 use crate::neighbors::UniformGrid;
 use crate::params::Params;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 impl StepBuffers {
     /// Reserves what steps of `fluid` fluid particles need, so that they allocate nothing
-    /// (docs/method.md §1.3): every per-particle buffer, the scratch of the sort, the fluid
-    /// neighbour lists for about `per_query` neighbours per particle (or what each block held
-    /// last time, with a quarter more), the boundary lists' blocks, and δ_k for
-    /// `iterations` outer iterations. What cannot be known before a step — more neighbours
-    /// than that, or the segments of kept corrections — may still grow during it.
+    /// where sizes are known (docs/method.md §1.3): every per-particle buffer, the scratch of
+    /// the sort, the fluid neighbour lists for about `per_query` neighbours per particle (or
+    /// what each block held last time, with a quarter more), the boundary lists' blocks, δ_k
+    /// for `iterations` outer iterations, and room to keep the state of `bodies` bodies and
+    /// `emitters` emitters for an undo. What cannot be known before a step — more
+    /// neighbours than that, the segments of kept corrections, a rebuilt grid — grows during
+    /// it through fallible reservations, and a step that cannot have it is undone.
     pub(crate) fn try_reserve(
         &mut self,
         fluid: usize,
         per_query: usize,
         iterations: usize,
-    ) -> Result<(), std::collections::TryReserveError> {
+        bodies: usize,
+        emitters: usize,
+    ) -> Result<(), TryReserveError> {
         use crate::reserve::reserve_total;
         for buffer in [
             &mut self.previous,
@@ -39,10 +46,17 @@ impl StepBuffers {
         reserve_total(&mut self.system.diagonal, fluid)?;
         reserve_total(&mut self.scratch_ids, fluid)?;
         reserve_total(&mut self.displacements, iterations)?;
-        self.table.try_reserve(fluid)?;
+        self.table.try_reserve(fluid, 0)?;
         self.corrections.try_reserve(fluid)?;
         self.fluid_lists.try_reserve(fluid, per_query)?;
-        self.boundary_lists.try_reserve(fluid, 0)
+        self.boundary_lists.try_reserve(fluid, 0)?;
+        self.undo.try_reserve(bodies, iterations, emitters)
+    }
+
+    /// Gives back the neighbour lists' storage, after a step that failed part-way grew them.
+    pub(super) fn release_lists(&mut self) {
+        self.fluid_lists.release();
+        self.boundary_lists.release();
     }
 }
 
@@ -78,26 +92,31 @@ pub(crate) struct SearchGrid {
 
 impl SearchGrid {
     /// Makes sure there is a grid and the boundary is sorted with volumes. The grid is
-    /// (re)built, with slack around `points` and the boundary, when there is none, when the
-    /// boundary changed, or when `outgrown` (some of `points` lie outside it) unless it
-    /// already hit its cell limit; then outlying particles are clamped into border cells,
-    /// which stays correct.
-    pub fn prepare(
+    /// (re)built, with slack around the prediction `b.current` and the boundary, when there
+    /// is none, when the boundary changed, or when `outgrown` (some of the prediction lies
+    /// outside it) unless it already hit its cell limit; then outlying particles are clamped
+    /// into border cells, which stays correct. The grid and the boundary as they were are
+    /// kept in `b.undo` first. Errors when memory for the grid, the copy or the sort cannot
+    /// be had.
+    fn prepare(
         &mut self,
         pool: &rayon::ThreadPool,
         params: &Params,
         kernel: &CubicKernel,
         boundary: &mut Boundary,
-        points: &[Vec3],
+        b: &mut StepBuffers,
         outgrown: bool,
-    ) {
+    ) -> Result<(), TryReserveError> {
+        let (points, undo) = (&b.current, &mut b.undo);
         let outgrown = self.grid.is_none() || (outgrown && !self.capped);
         if outgrown || boundary.dirty {
             let bounds = [points, &boundary.positions]
                 .iter()
                 .filter_map(|p| Aabb::around(p))
                 .reduce(|a, b| a.union(&b));
-            let Some(bounds) = bounds else { return };
+            let Some(bounds) = bounds else {
+                return Ok(());
+            };
             let finite = |v: Vec3| {
                 v.map(|c| {
                     if c.is_finite() {
@@ -111,33 +130,47 @@ impl SearchGrid {
             let slack = (bounds.max - bounds.min) * GRID_SLACK;
             let h = params.support_radius();
             let grid =
-                UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h);
-            self.capped = !pool.install(|| grid.covers(points));
-            self.grid = Some(grid);
+                UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h)?;
+            let capped = !pool.install(|| grid.covers(points));
+            boundary.save(&mut undo.boundary)?;
+            let replaced = std::mem::replace(
+                self,
+                SearchGrid {
+                    grid: Some(grid),
+                    capped,
+                },
+            );
+            // The grid from before the step, not one this step built and replaces again.
+            undo.grid.get_or_insert(replaced);
             boundary.dirty = true;
         }
         if boundary.dirty {
-            self.sort_boundary(pool, params, kernel, boundary);
+            boundary.save(&mut undo.boundary)?;
+            self.sort_boundary(pool, params, kernel, boundary)?;
         }
+        Ok(())
     }
 
     /// Sorts `boundary` into the grid's cells with fresh Akinci masses (nothing without a
-    /// grid).
+    /// grid); errors as [`Boundary::sort`].
     pub fn sort_boundary(
         &self,
         pool: &rayon::ThreadPool,
         params: &Params,
         kernel: &CubicKernel,
         boundary: &mut Boundary,
-    ) {
-        if let Some(grid) = &self.grid {
-            pool.install(|| boundary.sort(grid, kernel, params.rest_density));
+    ) -> Result<(), TryReserveError> {
+        match &self.grid {
+            Some(grid) => pool.install(|| boundary.sort(grid, kernel, params.rest_density)),
+            None => Ok(()),
         }
     }
 
     /// Prepares the grid around the prediction in `buffers.current` and sorts it into
     /// `buffers.order` and `buffers.table`; the sort's pass also tells whether the grid still
-    /// covers s, and if not the grid is rebuilt around it and s sorted again.
+    /// covers s, and if not the grid is rebuilt around it and s sorted again. Errors when
+    /// memory for the grid, the boundary's sort or the table cannot be had, with the grid
+    /// and the boundary as they were kept in `buffers.undo`.
     pub(super) fn sorted(
         &mut self,
         pool: &rayon::ThreadPool,
@@ -145,34 +178,31 @@ impl SearchGrid {
         kernel: &CubicKernel,
         boundary: &mut Boundary,
         b: &mut StepBuffers,
-    ) -> &UniformGrid {
-        self.prepare(pool, params, kernel, boundary, &b.current, false);
+    ) -> Result<&UniformGrid, TryReserveError> {
+        self.prepare(pool, params, kernel, boundary, b, false)?;
         let sort = |grid: &Option<UniformGrid>, b: &mut StepBuffers| {
             let grid = grid.as_ref().expect("prepare builds the grid");
             pool.install(|| grid.sort(&b.current, &mut b.order, &mut b.table))
         };
-        if !sort(&self.grid, b) && !self.capped {
-            self.prepare(pool, params, kernel, boundary, &b.current, true);
-            sort(&self.grid, b);
+        if !sort(&self.grid, b)? && !self.capped {
+            self.prepare(pool, params, kernel, boundary, b, true)?;
+            sort(&self.grid, b)?;
         }
-        self.grid.as_ref().expect("prepare builds the grid")
+        Ok(self.grid.as_ref().expect("prepare builds the grid"))
     }
 }
 
-/// Reorders all per-particle arrays by the sort's order, then finds the fluid and the
-/// boundary neighbours of every particle on s within the support radius `h` (m).
-pub(super) fn reorder_and_search(
+/// Reorders the prediction s by the sort's order, then finds the fluid and the boundary
+/// neighbours of every particle on s within the support radius `h` (m). Errors when the
+/// lists need more memory than can be had; the fluid is not touched either way.
+pub(super) fn search(
     grid: &UniformGrid,
-    fluid: &mut Fluid,
     boundary: &Boundary,
     h: f64,
     b: &mut StepBuffers,
-) {
+) -> Result<(), TryReserveError> {
     // X^(k−1) is free until the iteration starts: it serves as the scratch.
-    permute(&b.order, &mut fluid.positions, &mut b.previous);
-    permute(&b.order, &mut fluid.velocities, &mut b.previous);
     permute(&b.order, &mut b.current, &mut b.previous);
-    permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
     grid.search(
         &b.table,
         &b.current,
@@ -180,7 +210,7 @@ pub(super) fn reorder_and_search(
         h,
         true,
         &mut b.fluid_lists,
-    );
+    )?;
     grid.search_in(
         &boundary.table,
         &boundary.by_component,
@@ -188,7 +218,15 @@ pub(super) fn reorder_and_search(
         h,
         false,
         &mut b.boundary_lists,
-    );
+    )
+}
+
+/// Reorders the fluid's own arrays by the sort's order, as [`search`] reordered s: once the
+/// step can no longer fail. X^(k−1) of the finished iteration serves as the scratch.
+pub(super) fn permute_fluid(fluid: &mut Fluid, b: &mut StepBuffers) {
+    permute(&b.order, &mut fluid.positions, &mut b.previous);
+    permute(&b.order, &mut fluid.velocities, &mut b.previous);
+    permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
 }
 
 /// Reorders `data` so that slot k holds the old `data[order[k]]`.

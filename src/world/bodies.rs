@@ -68,6 +68,7 @@ impl World {
             let (kernel, rest_density) = (&self.constraint.kernel, self.params.rest_density);
             self.pool
                 .install(|| own_masses(&samples, kernel, rest_density))
+                .map_err(|_| Error::out_of_memory("body particles"))?
         };
         let body = spec.build(samples, psi)?;
         if kind == BodyKind::Static {

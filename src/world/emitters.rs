@@ -4,6 +4,8 @@
 use super::{MAX_PARTICLES, World};
 use crate::Error;
 use crate::emitter::{Emitter, EmitterSpec, EmitterState};
+use crate::reserve::reserve_total;
+use std::collections::TryReserveError;
 
 /// An emitter's handle within its world: the order in which it was added, from 0.
 pub type EmitterId = usize;
@@ -71,10 +73,12 @@ impl World {
 
     /// Inserts every emitter's due layers at the start of a step (emitters in order, each
     /// layer's free lattice points in lattice order), so that they get the next ids. The
-    /// caller checked the particle limit ([`World::check_emission`]).
-    pub(super) fn emit(&mut self) {
+    /// caller checked the particle limit ([`World::check_emission`]) and reserved the
+    /// fluid's storage; errors when memory for the layers' scratch cannot be had, with the
+    /// emitters part-way (the caller puts them back).
+    pub(super) fn emit(&mut self) -> Result<(), TryReserveError> {
         if self.emitters.is_empty() {
-            return;
+            return Ok(());
         }
         let (mut offsets, mut blocked, mut points) = (Vec::new(), Vec::new(), Vec::new());
         for emitter in &mut self.emitters {
@@ -82,6 +86,9 @@ impl World {
             if offsets.is_empty() {
                 continue;
             }
+            let lattice = offsets.len() * emitter.layer_len();
+            reserve_total(&mut blocked, lattice)?;
+            reserve_total(&mut points, lattice)?;
             // Against the fluid as it is, including the layers other emitters just inserted.
             emitter.mark_blocked(&offsets, &self.fluid.positions, &mut blocked);
             let velocity = emitter.velocity();
@@ -90,6 +97,7 @@ impl World {
             self.fluid
                 .push(&points, std::iter::repeat_n(velocity, points.len()));
         }
+        Ok(())
     }
 
     /// Adds a step of `dt` seconds to every emitter's travel.

@@ -8,6 +8,10 @@ use crate::boundary::{Aabb, akinci_volumes};
 use crate::constraint::Neighborhood;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 
+/// What a reading between steps panics with when its memory cannot be had: such readings
+/// (densities, pressures, probes) serve the Rust API and the tools, not the C API.
+const OUT_OF_MEMORY: &str = "out of memory for a reading of the particles between steps";
+
 /// Fluid and boundary particles sorted into one grid of cell size H, the boundary with its
 /// Akinci masses.
 pub(crate) struct Snapshot {
@@ -36,14 +40,18 @@ impl Snapshot {
     /// indices into `fluid`, ascending.
     pub fn fluid_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
         let (table, points) = (&self.fluid_table, &self.fluid_components);
-        self.grid.search_in(table, points, queries, h, false, out);
+        self.grid
+            .search_in(table, points, queries, h, false, out)
+            .expect(OUT_OF_MEMORY);
     }
 
     /// For every query point, the boundary particles within the support radius `h` (m), as
     /// indices into `boundary`, ascending.
     pub fn boundary_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
         let (table, points) = (&self.boundary_table, &self.boundary_components);
-        self.grid.search_in(table, points, queries, h, false, out);
+        self.grid
+            .search_in(table, points, queries, h, false, out)
+            .expect(OUT_OF_MEMORY);
     }
 }
 
@@ -51,7 +59,7 @@ impl World {
     /// The fluid and boundary particles sorted into a fresh grid, or `None` when there are
     /// none. Runs on the caller's thread pool (call it inside the world's). Before the first
     /// step the boundary has no masses yet; they are then computed here as the step would,
-    /// over the boundary particles there are.
+    /// over the boundary particles there are. Panics when the memory cannot be had.
     pub(crate) fn snapshot(&self) -> Option<Snapshot> {
         let h = self.params.support_radius();
         let fluid = &self.fluid.positions;
@@ -60,10 +68,10 @@ impl World {
             .iter()
             .filter_map(|p| Aabb::around(p))
             .reduce(|a, b| a.union(&b))?;
-        let grid = UniformGrid::covering(bounds.min, bounds.max, h);
+        let grid = UniformGrid::covering(bounds.min, bounds.max, h).expect(OUT_OF_MEMORY);
         let sorted = |points: &[Vec3], table: &mut CellTable| {
             let mut order = Vec::new();
-            grid.sort(points, &mut order, table);
+            grid.sort(points, &mut order, table).expect(OUT_OF_MEMORY);
             order
         };
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
@@ -76,8 +84,8 @@ impl World {
             .collect();
         let (mut fluid_components, mut boundary_components) =
             (PointsByComponent::default(), PointsByComponent::default());
-        fluid_components.fill(&fluid);
-        boundary_components.fill(&bx);
+        fluid_components.fill(&fluid).expect(OUT_OF_MEMORY);
+        boundary_components.fill(&bx).expect(OUT_OF_MEMORY);
         let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
             boundary_order
                 .iter()
@@ -86,6 +94,7 @@ impl World {
         } else {
             let kernel = &self.constraint.kernel;
             akinci_volumes(&grid, &boundary_table, &bx, &boundary_components, kernel)
+                .expect(OUT_OF_MEMORY)
                 .into_iter()
                 .map(|v| v * self.params.rest_density)
                 .collect()
@@ -117,7 +126,8 @@ impl World {
             (NeighborLists::default(), NeighborLists::default());
         snapshot
             .grid
-            .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists);
+            .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists)
+            .expect(OUT_OF_MEMORY);
         snapshot.boundary_near(x, h, &mut boundary_lists);
         let mut weights = Vec::new();
         self.constraint.weights(&fluid_lists, &mut weights);
@@ -134,6 +144,9 @@ impl World {
     /// ascending id order (see [`World::ids`]). Unlike [`World::densities`], which reports
     /// the densities the last step ended with, this evaluates them now: before the first step
     /// it shows whether the fluid starts at rest density, against walls and obstacles too.
+    ///
+    /// # Panics
+    /// When the memory for the neighbour search cannot be had.
     pub fn current_densities(&self) -> Vec<f64> {
         let in_storage_order = self.pool.install(|| {
             let Some(snapshot) = self.snapshot() else {

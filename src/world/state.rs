@@ -117,7 +117,8 @@ impl World {
     /// with `state`, as [`World::export_state`] returned it; the world's parameters stay.
     /// Rejects a state whose arrays differ in length, whose values are not finite, whose ids
     /// repeat or reach `next_id`, whose counts disagree, whose boxes or emitters are invalid
-    /// or whose grid is invalid, changing nothing.
+    /// or whose grid is invalid, changing nothing; so does ([`Error::OutOfMemory`]) a
+    /// shortage of memory for the grid and the boundary's sort.
     pub fn import_state(&mut self, state: WorldState) -> Result<(), Error> {
         let n = state.positions.len();
         for (name, len) in [
@@ -196,15 +197,32 @@ impl World {
         if n > super::MAX_PARTICLES || state.boundary_positions.len() > super::MAX_PARTICLES {
             return Err(Error::invalid("state", n, "exceeds the particle limit"));
         }
+        let oom = |_| Error::out_of_memory("the neighbour grid and the boundary");
         let grid = match state.grid {
             None => None,
             Some(g) => Some(
                 UniformGrid::from_parts_checked(Vec3::from(g.origin), g.cell_size, g.dims)
                     .ok_or_else(|| {
                         Error::invalid("state.grid", format!("{g:?}"), "is not a valid grid")
-                    })?,
+                    })?
+                    .map_err(oom)?,
             ),
         };
+        let grid = SearchGrid {
+            grid,
+            capped: state.grid_capped,
+        };
+        // A sorted boundary was saved in its sorted order: sorting again keeps that order and
+        // recomputes the same volumes. Sorted before anything is replaced, so that a
+        // shortage of memory changes nothing.
+        let mut boundary = self
+            .boundary
+            .with_statics(state.boundary_positions, state.boundary_owners);
+        if state.boundary_sorted {
+            let kernel = &self.constraint.kernel;
+            grid.sort_boundary(&self.pool, &self.params, kernel, &mut boundary)
+                .map_err(oom)?;
+        }
         let fluid = &mut self.fluid;
         fluid.positions = state.positions;
         fluid.velocities = state.velocities;
@@ -213,9 +231,7 @@ impl World {
         fluid.ascending = ascending;
         fluid.next_id = state.next_id;
         fluid.removed = state.removed_count;
-        self.boundary.positions = state.boundary_positions;
-        self.boundary.owner = state.boundary_owners;
-        self.boundary.psi.clear();
+        self.boundary = boundary;
         for (body, b) in self.bodies.iter_mut().zip(&state.bodies) {
             body.set_state(b);
         }
@@ -227,18 +243,7 @@ impl World {
         self.steps = state.steps;
         self.next_dt = state.next_dt;
         self.chebyshev.set_online(state.online_rho);
-        self.grid = SearchGrid {
-            grid,
-            capped: state.grid_capped,
-        };
-        // A sorted boundary was saved in its sorted order: sorting again keeps that order and
-        // recomputes the same volumes.
-        self.boundary.dirty = !state.boundary_sorted || self.grid.grid.is_none();
-        if !self.boundary.dirty {
-            let kernel = &self.constraint.kernel;
-            self.grid
-                .sort_boundary(&self.pool, &self.params, kernel, &mut self.boundary);
-        }
+        self.grid = grid;
         self.last = None;
         Ok(())
     }

@@ -4,7 +4,10 @@
 //!
 //! A call either succeeds or changes nothing: everything that can fail — the sizes, the
 //! presence of fluid, the particle limit over the emitters' output, the memory the steps
-//! need — is checked before the first step, after which the steps cannot fail.
+//! need as far as it can be known — is checked before the first step. What only a step
+//! can size (neighbour lists beyond their reservation, a rebuilt grid, kept corrections)
+//! it reserves fallibly; a step that cannot have it is undone, and a run of steps ends
+//! there with the steps before it kept.
 
 use super::World;
 use crate::Error;
@@ -41,7 +44,9 @@ impl World {
     ///
     /// Errors, changing nothing: a bad `dt` (or one so short that the clock, at the current
     /// time, would not move), no fluid, emitters that would exceed the particle limit, or
-    /// ([`Error::OutOfMemory`]) too little memory for the step.
+    /// ([`Error::OutOfMemory`]) too little memory for the step — for its buffers, or for
+    /// neighbour lists, a grid or corrections that grow during it (a fluid compressed far
+    /// beyond rest, e.g. particles placed on top of each other, needs many more neighbours).
     pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
         check_step("dt", dt)?;
         if self.time + dt == self.time {
@@ -52,7 +57,7 @@ impl World {
             ));
         }
         self.prepare_steps(0.0)?;
-        Ok(self.take_prepared_step(dt))
+        self.take_prepared_step(dt)
     }
 
     /// Takes one step that ends at simulated time `end` (s) exactly: a step of
@@ -89,9 +94,15 @@ impl World {
         self.try_reserve_fluid(most - self.fluid_count())
             .map_err(oom)?;
         let per_query = (self.params.rest_stencil_size() * NEIGHBOR_SLACK).ceil() as usize;
+        let iterations = self.params.max_outer_iterations;
+        let (bodies, emitters) = (self.bodies.len(), self.emitters.len());
         self.buffers
-            .try_reserve(most, per_query, self.params.max_outer_iterations)
+            .try_reserve(most, per_query, iterations, bodies, emitters)
             .map_err(oom)?;
+        self.solver.try_reserve(most).map_err(oom)?;
+        for force in &mut self.forces {
+            force.try_reserve(most).map_err(oom)?;
+        }
         if self.boundary.dirty {
             crate::reserve::probe(self.boundary_count() as f64 * BOUNDARY_SORT_BYTES)
                 .map_err(oom)?;
@@ -99,9 +110,20 @@ impl World {
         Ok(())
     }
 
-    /// One step of `dt` seconds, after [`World::prepare_steps`] checked everything.
-    fn take_prepared_step(&mut self, dt: f64) -> &StepStats {
-        self.emit();
+    /// One step of `dt` seconds, after [`World::prepare_steps`] checked everything it can.
+    /// Errors ([`Error::OutOfMemory`]) when the step needs more memory than can be had,
+    /// having changed nothing.
+    fn take_prepared_step(&mut self, dt: f64) -> Result<&StepStats, Error> {
+        let oom = |_| Error::out_of_memory("the neighbour lists and corrections of a time step");
+        self.buffers
+            .undo
+            .before_emission(&self.fluid, &self.emitters);
+        if let Err(e) = self.emit() {
+            self.buffers
+                .undo
+                .undo_emission(&mut self.fluid, &mut self.emitters);
+            return Err(oom(e));
+        }
         let inflow_speed = self.inflow_speed(self.time + dt);
         let idle = self.fluid_count() == 0;
         let World {
@@ -141,14 +163,22 @@ impl World {
         let (stats, next_dt) = if idle {
             idle_step(context, dt)
         } else {
-            take_step(context, dt)
+            match take_step(context, dt) {
+                Ok(taken) => taken,
+                Err(e) => {
+                    self.buffers
+                        .undo
+                        .undo_emission(&mut self.fluid, &mut self.emitters);
+                    return Err(oom(e));
+                }
+            }
         };
         self.next_dt = next_dt;
         self.time += dt;
         self.steps += 1;
         self.advance_emitters(dt);
         self.drain();
-        self.last.insert(stats)
+        Ok(self.last.insert(stats))
     }
 
     /// Steps until `seconds` more simulated time has passed; the last step is shortened to
@@ -158,7 +188,9 @@ impl World {
     /// which the clock no longer resolves such a step. Errors, changing nothing: a bad
     /// `seconds`, no fluid, emitters that could
     /// exceed the particle limit within `seconds`, or ([`Error::OutOfMemory`]) too little
-    /// memory for the steps.
+    /// memory for the steps. A step that runs out of memory for what grows during it
+    /// ([`World::step_with_dt`]) ends the run with [`Error::OutOfMemory`]: that step changes
+    /// nothing, the steps before it are kept ([`World::time`] tells how far the run got).
     pub fn advance(&mut self, seconds: f64) -> Result<usize, Error> {
         self.advance_with(seconds, |_| Ok(()))
     }
@@ -244,7 +276,7 @@ impl World {
         while !landed(self.time) {
             // next_dt lies in [dt_min, dt_max] (the CFL rule clamps it), so dt is valid.
             let dt = self.next_dt.min(end - self.time);
-            self.take_prepared_step(dt);
+            self.take_prepared_step(dt)?;
             after(self, dt)?;
             steps += 1;
         }

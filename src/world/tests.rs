@@ -235,6 +235,44 @@ mod step {
         }
     }
 
+    /// A step whose local step cannot have the memory for the corrections it keeps (refused
+    /// by the test's limit on their segments, as a shortage of memory would refuse them)
+    /// fails after its searches, in its iteration, and changes nothing: not the particles or
+    /// their order, the grid, the boundary, nor the last step's displacements. With the
+    /// memory back it steps on bit for bit as a world that never failed.
+    #[test]
+    fn a_step_that_cannot_keep_its_corrections_changes_nothing() {
+        // Stepped until some constraints are active, whose projections keep corrections.
+        let build = || {
+            let mut world = small_dam_break();
+            world.constraint.materialize_all = true;
+            while world.buffers.corrections.kept() == 0 {
+                assert!(world.steps() < 50, "no constraint became active");
+                world.step().unwrap();
+            }
+            world
+        };
+        let everything = |world: &World| {
+            let displacements = world.last_displacements().to_vec();
+            let boundary = world.boundary_positions().to_vec();
+            (fingerprint(world), boundary, displacements)
+        };
+        let mut world = build();
+        let before = everything(&world);
+        assert!(!before.2.is_empty());
+        world.buffers.corrections.segment_limit = Some(0);
+        let error = world.step().map(|_| ()).unwrap_err();
+        assert!(matches!(error, crate::Error::OutOfMemory(_)), "{error}");
+        assert!(everything(&world) == before);
+        world.buffers.corrections.segment_limit = None;
+        let mut twin = build();
+        for _ in 0..2 {
+            world.step().unwrap();
+            twin.step().unwrap();
+            assert!(everything(&world) == everything(&twin));
+        }
+    }
+
     /// Relaxation steps exactly as [`World::advance`] does and then scales every velocity by
     /// exp(−damping·Δt): a plain world stepped over the same step sizes, its velocities
     /// scaled by hand after each step, ends bitwise the same; damping 0 is bitwise

@@ -11,7 +11,9 @@ use crate::ffi::status::{Failure, PfStatus, status_call};
 /// Errors: `PF_ERROR_INVALID_ARGUMENT` (dt NaN, infinite, above 1, or so short that the
 /// time would not change, e.g. 1e-300; no fluid particles;
 /// emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
-/// buffers and neighbour lists, reserved before it starts). On any error the world is
+/// buffers and neighbour lists, reserved before it starts, or what only the step can size
+/// and grows during it: neighbour lists of a fluid compressed far beyond rest, a rebuilt
+/// neighbour grid, the corrections its projections keep). On any error the world is
 /// unchanged.
 ///
 /// # Safety
@@ -44,11 +46,12 @@ pub unsafe extern "C" fn pf_world_step(world: *mut PfWorld, dt: f64) -> PfStatus
 ///
 /// Errors: `PF_ERROR_INVALID_ARGUMENT` (seconds negative, not finite, between 0 and dt_min,
 /// or ending too late; no fluid particles; emitters that could exceed the particle limit within
-/// `seconds`), `PF_ERROR_OUT_OF_MEMORY`. The call succeeds or changes nothing: everything is
-/// checked, and the storage the steps need (particles the emitters may insert, buffers,
-/// neighbour lists for up to 1.25 times the neighbours of fluid at rest) reserved, before
-/// the first step. Neighbour lists that outgrow that reservation in a strongly compressed
-/// fluid still grow during a step, where running out of memory aborts as in any program.
+/// `seconds`), `PF_ERROR_OUT_OF_MEMORY`. Everything is checked, and the storage the steps
+/// need (particles the emitters may insert, buffers, neighbour lists for up to 1.25 times
+/// the neighbours of fluid at rest) reserved, before the first step: such an error changes
+/// nothing. What only a step can size grows during it (`pf_world_step`); a step that cannot
+/// have that memory returns `PF_ERROR_OUT_OF_MEMORY` having changed nothing, and ends the
+/// call there with the steps before it kept (`pf_world_time` tells how far it got).
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.
@@ -70,7 +73,9 @@ pub unsafe extern "C" fn pf_world_advance(world: *mut PfWorld, seconds: f64) -> 
 /// packing, from which it stays at rest under the calm settings (`pf_params_calm`).
 ///
 /// Errors: those of `pf_world_advance`, and `PF_ERROR_INVALID_ARGUMENT` for a damping that
-/// is negative or not finite; on any error no step is taken and the world is unchanged.
+/// is negative or not finite; on any error no step is taken and the world is unchanged,
+/// except that a step that runs out of memory part-way through the call ends it there, as
+/// in `pf_world_advance`.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.

@@ -1057,10 +1057,11 @@ fn damaged_checkpoints_exit_2_with_a_clear_message() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// A small tank whose own `probes` (a gauge read at 50 Hz) the probes files replace.
+/// A small tank whose own `probes` (a gauge read at 50 Hz) the probes files replace; its walls
+/// r/4 beyond one spacing from the water, so that no corner starts compressed.
 const PROBE_TANK: &str = r#"{
   "particle_radius": 0.025,
-  "container": {"min": [0, 0, 0], "max": [0.4, 0.4, 0.3]},
+  "container": {"min": [-0.00625, -0.00625, -0.00625], "max": [0.4, 0.4, 0.3]},
   "fluid_blocks": [{"start": [0.05, 0.05, 0.05], "count": [6, 4, 4]}],
   "duration": 0.05,
   "probes": {"rate": 50, "gauges": [{"name": "S", "x": 0.2, "z": 0.15}]}
@@ -1071,7 +1072,7 @@ const PROBES: &str = r#"{
   "rate": 200,
   "gauges": [{"name": "H1", "x": 0.15, "z": 0.15}, {"name": "H2", "x": 0.25, "z": 0.15, "bottom": 0.0, "top": 0.35}],
   "pressure": [{"name": "P1", "position": [0.2, 0.06, 0.15]},
-               {"name": "W1", "position": [0.0, 0.06, 0.15], "wall": true}]
+               {"name": "W1", "position": [-0.00625, 0.06, 0.15], "wall": true}]
 }"#;
 
 /// `--probes FILE` replaces the scene's probes and writes probes.csv beside the frames: a

@@ -58,3 +58,20 @@ fn check_frame(time: f64, n: usize, velocities: &[Vec3], densities: &[f64]) -> R
     }
     Ok(())
 }
+
+/// A frame of three particles whose values exercise signs, zeros and small magnitudes, for the
+/// writers' read-back tests: positions (m), velocities (m/s) and densities (kg/m³).
+#[cfg(test)]
+fn sample_frame() -> (Vec<Vec3>, Vec<Vec3>, Vec<f64>) {
+    let positions = vec![
+        Vec3::new(0.1, 0.2, 0.3),
+        Vec3::new(-1.5, 2.25, 1e-7),
+        Vec3::new(3.0, 0.0, -0.125),
+    ];
+    let velocities = vec![
+        Vec3::new(1.0, -2.0, 0.5),
+        Vec3::zeros(),
+        Vec3::new(0.333, 1e3, -7.0),
+    ];
+    (positions, velocities, vec![1000.0, 998.25, 1012.5])
+}

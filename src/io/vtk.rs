@@ -202,17 +202,7 @@ mod tests {
 
     #[test]
     fn frame_reads_back_exactly() {
-        let positions = vec![
-            Vec3::new(0.1, 0.2, 0.3),
-            Vec3::new(-1.5, 2.25, 1e-7),
-            Vec3::new(3.0, 0.0, -0.125),
-        ];
-        let velocities = vec![
-            Vec3::new(1.0, -2.0, 0.5),
-            Vec3::zeros(),
-            Vec3::new(0.333, 1e3, -7.0),
-        ];
-        let densities = vec![1000.0, 998.25, 1012.5];
+        let (positions, velocities, densities) = super::super::sample_frame();
         let path = temp_path("frame.vtk");
         let time = 0.1 + 0.2;
         write_vtk(&path, time, &positions, &velocities, &densities).unwrap();

@@ -40,8 +40,8 @@ pub(crate) fn reserve_scratch(
 
 /// The default [`DensityConstraint::membership_floor`]: particles with fewer than 15 fluid
 /// neighbours (spray, thin sheets) are counted in 16 stencils by the global step. Measured on
-/// `dam_break_30k` (docs/method.md §3.1): the largest density error of its 2 s fell from
-/// 14.2 % to 1.2 %, with fewer outer iterations.
+/// `dam_break_30k` at mass factor 0.8 (docs/method.md §3.1): the largest density error of its
+/// 2 s fell from 14.2 % to 1.2 %, with fewer outer iterations.
 pub const MEMBERSHIP_FLOOR: f64 = 16.0;
 /// The local projection stops once C_i ≤ this value (Sommer et al. 2020, Weiler et al. 2016).
 const CONSTRAINT_GOAL: f64 = 1e-14;

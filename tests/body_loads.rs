@@ -202,14 +202,15 @@ fn the_fluid_gains_the_momentum_the_paddle_reports_losing() {
     );
 }
 
-/// With the default weighting the fluid's own forces are not conservative (§2.5, §11.3): the
-/// water gains a few percent more momentum than any boundary gave it.
+/// With the default weighting the fluid's own forces are not exactly conservative (§2.5,
+/// §11.3), but with the membership floor (§3.1) the water gains what the paddle gave within
+/// 3 % (measured: 0.4 % less).
 #[test]
-fn with_neighbour_count_weights_the_fluid_gains_a_few_percent_more_than_the_paddle_gave() {
+fn with_neighbour_count_weights_the_fluid_gains_what_the_paddle_gave_within_3_percent() {
     let (gained, paddle, _) = paddle_push(ProjectionWeight::NeighborCount);
     let surplus = gained / -paddle - 1.0;
     assert!(
-        (0.0..0.08).contains(&surplus),
+        surplus.abs() < 0.03,
         "fluid gained {gained:.2} N·s, paddle reports {paddle:.2} N·s"
     );
 }

@@ -4,7 +4,8 @@
 use super::gather::Corrections;
 use super::stencil::{SCRATCH, Scratch};
 use super::{
-    CHUNK, CONSTRAINT_GOAL, DensityConstraint, MAX_PROJECTION_STEPS, Neighborhood, REGULARIZATION,
+    CHUNK, CONSTRAINT_GOAL, DensityConstraint, MAX_PROJECTION_STEPS, NEWTON_STEP_LIMIT,
+    Neighborhood, REGULARIZATION,
 };
 use crate::Vec3;
 use crate::neighbors::par_segments_zip_mut;
@@ -167,6 +168,31 @@ impl DensityConstraint {
         (grad_i, denominator + grad_i.norm_squared())
     }
 
+    /// λ of a Newton step after the first, shortened so that no member of the stencil moves
+    /// farther than [`NEWTON_STEP_LIMIT`]·H: `own` is particle i's weighted gradient, `grads`
+    /// the members' gradients and `w` their weights.
+    #[inline(never)]
+    fn bounded_newton_step(
+        &self,
+        lambda: f64,
+        own: Vec3,
+        grads: &[Vec3],
+        w: impl Fn(usize) -> f64,
+    ) -> f64 {
+        let largest = grads
+            .iter()
+            .enumerate()
+            .map(|(s, g)| g.norm() * w(s))
+            .fold(own.norm(), f64::max)
+            * lambda.abs();
+        let limit = NEWTON_STEP_LIMIT * self.kernel.support_radius();
+        if largest > limit {
+            lambda * (limit / largest)
+        } else {
+            lambda
+        }
+    }
+
     crate::simd::avx2_dispatch! {
         /// Projection of constraint i (docs/method.md §2.5): Newton-like steps on a private
         /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after
@@ -238,8 +264,11 @@ impl DensityConstraint {
             if denominator == 0.0 {
                 break;
             }
-            let lambda = -c / (denominator + REGULARIZATION);
+            let mut lambda = -c / (denominator + REGULARIZATION);
             let w_i = self.weight_of(nb, i);
+            if materialized {
+                lambda = self.bounded_newton_step(lambda, grad_i * w_i, &scratch.grads, w);
+            }
             out.self_correction += grad_i * (lambda * w_i);
             if step == 0 && !self.evaluate_first_step && !self.materialize_all {
                 relaxes = self.first_step_surely_relaxes(rho, lambda, grad_i, w_i, scratch);

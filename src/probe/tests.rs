@@ -165,9 +165,11 @@ fn small_tank(threads: usize) -> World {
         ..Params::default()
     })
     .unwrap();
+    // Walls r/4 outside the nominal 0.5 m box, so that no fluid particle starts compressed.
+    let gap = 0.25 * world.params().particle_radius;
     let tank = Aabb {
-        min: Vec3::zeros(),
-        max: Vec3::repeat(0.5),
+        min: Vec3::repeat(-gap),
+        max: Vec3::repeat(0.5 + gap),
     };
     world.add_container(tank, 1).unwrap();
     world

@@ -54,7 +54,9 @@ typedef enum PfStatus {
     /**
      * Memory could not be allocated: for particles, boundaries, meshes, or what the next
      * steps need (buffers and neighbour lists reserved before the first step of a call, or
-     * neighbour lists, grid and corrections that grow during a step).
+     * what grows during a step: neighbour lists, grid, corrections, the body coupling, the
+     * LDLᵀ factorisation). A step aborts for want of memory only in the thread pool's own
+     * bookkeeping (a few hundred bytes).
      */
     PF_ERROR_OUT_OF_MEMORY = 4,
     /**
@@ -737,8 +739,10 @@ enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out)
  * emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
  * buffers and neighbour lists, reserved before it starts, or what only the step can size
  * and grows during it: neighbour lists of a fluid compressed far beyond rest, a rebuilt
- * neighbour grid, the corrections its projections keep). On any error the world is
- * unchanged.
+ * neighbour grid, the corrections its projections keep, the coupling of the fluid to
+ * bodies, the LDLᵀ factorisation). On any error the world is unchanged. A step does not
+ * abort for want of memory, short of the thread pool's own bookkeeping (a few hundred
+ * bytes).
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`.

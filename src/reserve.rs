@@ -9,6 +9,14 @@ pub(crate) fn reserve_total<T>(v: &mut Vec<T>, total: usize) -> Result<(), TryRe
     v.try_reserve(total.saturating_sub(v.len()))
 }
 
+/// The error that reports a shortage found by a library that does not say more (a failed
+/// allocation inside a factorisation): the one of a request no allocator could grant.
+pub(crate) fn shortage() -> TryReserveError {
+    Vec::<u8>::new()
+        .try_reserve(usize::MAX)
+        .expect_err("no allocation has usize::MAX bytes")
+}
+
 /// Checks that `bytes` of working memory can be had right now, by allocating and freeing
 /// them: for work whose allocations happen deep inside an algorithm (a mesh's sampling, a
 /// boundary's sort) and cannot all be reserved one by one. A check, not a reservation.
@@ -31,5 +39,6 @@ mod tests {
         assert_eq!(v, [1, 2]);
         probe(1e6).unwrap();
         assert!(probe(1e30).is_err());
+        let _: TryReserveError = shortage();
     }
 }

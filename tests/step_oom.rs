@@ -8,25 +8,72 @@
 //! This test program's allocator refuses, while a limit is set, every allocation larger than
 //! the limit. Crowded particles need lists far longer than anything else these small worlds
 //! allocate, so the refusal falls where the step grows them.
+//!
+//! It also refuses, on request, one allocation at a given count on a world's own threads:
+//! refusing each allocation of a step in turn, in worlds with bodies (their coupling to the
+//! fluid, docs/method.md §11.3) and the LDLᵀ solver (its factorisation), every one must make
+//! the step fail with `Error::OutOfMemory`, changing nothing; none may abort the process.
 
-use projfluid::body::{BodyKind, BodySpec, Pose, Rotation, Shape, Velocity};
+use projfluid::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
 use projfluid::boundary::Aabb;
-use projfluid::{EmitterShape, EmitterSpec, Error, Params, Vec3, World, WorldState};
+use projfluid::{EmitterShape, EmitterSpec, Error, Params, SolverKind, Vec3, World, WorldState};
 use std::alloc::{GlobalAlloc, Layout, System};
+use std::cell::Cell;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// The largest allocation (bytes) the allocator grants; `usize::MAX` while no limit is set.
 static GRANTED: AtomicUsize = AtomicUsize::new(usize::MAX);
 
-/// The system allocator, refusing allocations above [`GRANTED`] as an exhausted one would.
+/// How many more allocations larger than [`BOOKKEEPING`] on [`MARKED`] threads the
+/// allocator grants before it refuses one; `usize::MAX` while none is to be refused.
+static COUNTDOWN: AtomicUsize = AtomicUsize::new(usize::MAX);
+
+/// Allocations of at most this many bytes are not counted down. Among them is the one
+/// allocation of a step that cannot fail gracefully: rayon's record of a broadcast to the
+/// pool's threads (a few dozen bytes per thread), when the step widens every thread's scratch
+/// for larger stencils than any before. Everything the step sizes by particles, slots or
+/// factors is larger in these worlds.
+const BOOKKEEPING: usize = 512;
+
+/// Set when the allocator refused the allocation [`COUNTDOWN`] counted down to.
+static REFUSED: AtomicBool = AtomicBool::new(false);
+
+thread_local! {
+    /// Whether this thread's allocations count down [`COUNTDOWN`]: the threads of the worlds
+    /// built by [`bodies_world`], where their steps do their work.
+    static MARKED: Cell<bool> = const { Cell::new(false) };
+}
+
+/// Whether an allocation of `size` bytes is to be refused.
+fn refuse(size: usize) -> bool {
+    if size > GRANTED.load(Ordering::SeqCst) {
+        return true;
+    }
+    if !MARKED.with(Cell::get) || size <= BOOKKEEPING {
+        return false;
+    }
+    let counted = COUNTDOWN.fetch_update(Ordering::SeqCst, Ordering::SeqCst, |left| match left {
+        usize::MAX => None,
+        0 => Some(usize::MAX),
+        left => Some(left - 1),
+    });
+    let refused = counted == Ok(0);
+    if refused {
+        REFUSED.store(true, Ordering::SeqCst);
+    }
+    refused
+}
+
+/// The system allocator, refusing allocations above [`GRANTED`], and the one [`COUNTDOWN`]
+/// counts down to, as an exhausted one would.
 struct Limited;
 
 // SAFETY: every call is passed on to the system allocator unchanged, or refused with a null
 // pointer, which the `GlobalAlloc` contract allows.
 unsafe impl GlobalAlloc for Limited {
     unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        if layout.size() > GRANTED.load(Ordering::SeqCst) {
+        if refuse(layout.size()) {
             return std::ptr::null_mut();
         }
         // SAFETY: the caller's guarantees for `layout` are the system allocator's.
@@ -34,7 +81,7 @@ unsafe impl GlobalAlloc for Limited {
     }
 
     unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        if layout.size() > GRANTED.load(Ordering::SeqCst) {
+        if refuse(layout.size()) {
             return std::ptr::null_mut();
         }
         // SAFETY: as `alloc`.
@@ -47,7 +94,7 @@ unsafe impl GlobalAlloc for Limited {
     }
 
     unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        if new_size > GRANTED.load(Ordering::SeqCst) {
+        if refuse(new_size) {
             return std::ptr::null_mut();
         }
         // SAFETY: `ptr` came from the system allocator with `layout`.
@@ -254,4 +301,143 @@ fn grown_lists_give_the_same_step_on_one_and_three_threads() {
     one.step().unwrap();
     three.step().unwrap();
     assert!(fingerprint(&one) == fingerprint(&three));
+}
+
+/// A 0.6 m box holding a block of water 0.4 m × 0.25 m × 0.4 m, a dynamic cube falling into
+/// it and a kinematic paddle pushed into it, stepped by the LDLᵀ solver on a pool of
+/// `threads` threads whose allocations [`COUNTDOWN`] counts.
+fn bodies_world(threads: usize) -> World {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .start_handler(|_| MARKED.with(|marked| marked.set(true)))
+        .build()
+        .unwrap();
+    let params = Params {
+        threads,
+        solver: SolverKind::Ldlt,
+        ..Params::default()
+    };
+    let mut world = World::with_pool(params, pool).unwrap();
+    let room = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.6),
+    };
+    world.add_container(room, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(0.1), [8, 5, 8], Vec3::zeros())
+        .unwrap();
+    let body = |kind, half_extents, mass, position, linear| BodySpec {
+        kind,
+        mesh: Shape::Box { half_extents }.mesh(0.025).unwrap(),
+        mass,
+        pose: Pose {
+            position,
+            rotation: Rotation::identity(),
+        },
+        velocity: Velocity {
+            linear,
+            angular: Vec3::zeros(),
+        },
+        motion: None,
+    };
+    let cube = body(
+        BodyKind::Dynamic,
+        Vec3::repeat(0.06),
+        Some(BodyMass::Density(500.0)),
+        Vec3::new(0.35, 0.39, 0.3),
+        Vec3::zeros(),
+    );
+    world.add_body(cube).unwrap();
+    let paddle = body(
+        BodyKind::Kinematic,
+        Vec3::new(0.02, 0.15, 0.1),
+        None,
+        Vec3::new(0.05, 0.2, 0.3),
+        Vec3::new(0.3, 0.0, 0.0),
+    );
+    world.add_body(paddle).unwrap();
+    world
+}
+
+/// Takes the next step once for every allocation it makes on the world's threads, refusing
+/// that allocation: each such step must fail with `Error::OutOfMemory` and change nothing.
+/// The last one, in which nothing was refused, takes the step. Returns the number of
+/// allocations refused.
+fn refuse_each_allocation(world: &mut World) -> usize {
+    /// Stops counting down, also if the step panics.
+    struct Disarm;
+    impl Drop for Disarm {
+        fn drop(&mut self) {
+            COUNTDOWN.store(usize::MAX, Ordering::SeqCst);
+        }
+    }
+    let before = fingerprint(world);
+    for granted in 0..100_000 {
+        REFUSED.store(false, Ordering::SeqCst);
+        let stepped = {
+            let _disarm = Disarm;
+            COUNTDOWN.store(granted, Ordering::SeqCst);
+            world.step().map(|_| ())
+        };
+        if !REFUSED.load(Ordering::SeqCst) {
+            stepped.unwrap();
+            return granted;
+        }
+        let error = stepped.expect_err("a step succeeded without an allocation it made");
+        assert!(matches!(error, Error::OutOfMemory(_)), "{error}");
+        assert!(error.to_string().contains("of a time step"), "{error}");
+        let after = fingerprint(world);
+        assert!(
+            after == before,
+            "refusing allocation {granted} changed the world"
+        );
+    }
+    panic!("the step made more than 100000 allocations");
+}
+
+/// The first step of a world with bodies and the LDLᵀ solver — its grid, the boundary's sort,
+/// the bodies' placement, the coupling's slots, the factorisation — fails with
+/// `OutOfMemory` and changes nothing wherever an allocation is refused; then it steps bit for
+/// bit as a world that never failed, and so does its next step.
+#[test]
+fn every_allocation_of_a_first_step_with_bodies_and_ldlt_can_fail() {
+    let _serial = serial();
+    let mut world = bodies_world(1);
+    assert!(refuse_each_allocation(&mut world) > 0);
+    let mut twin = bodies_world(1);
+    twin.step().unwrap();
+    assert!(fingerprint(&world) == fingerprint(&twin));
+    world.step().unwrap();
+    twin.step().unwrap();
+    assert!(fingerprint(&world) == fingerprint(&twin));
+}
+
+/// A later step on three threads, after more water was placed at the paddle (the coupling
+/// needs more slots), fails with `OutOfMemory` and changes nothing wherever an
+/// allocation is refused; then it steps on bit for bit as a world that never failed.
+#[test]
+fn every_allocation_of_a_later_step_with_bodies_and_ldlt_can_fail() {
+    let _serial = serial();
+    let build = || {
+        let mut world = bodies_world(3);
+        world.step().unwrap();
+        world.step().unwrap();
+        world
+            .add_fluid_block(Vec3::new(0.1, 0.36, 0.1), [3, 2, 8], Vec3::zeros())
+            .unwrap();
+        world
+    };
+    let mut world = build();
+    let bodies_before = world.export_state().bodies;
+    assert!(refuse_each_allocation(&mut world) > 0);
+    assert!(
+        world.export_state().bodies != bodies_before,
+        "the bodies did not move"
+    );
+    let mut twin = build();
+    twin.step().unwrap();
+    assert!(fingerprint(&world) == fingerprint(&twin));
+    world.step().unwrap();
+    twin.step().unwrap();
+    assert!(fingerprint(&world) == fingerprint(&twin));
 }

@@ -121,7 +121,7 @@ impl DensityConstraint {
         // lists, and six times their bytes.
         #[cfg(test)]
         if c.segment_limit.is_some_and(|limit| segments > limit) {
-            return Err(Vec::<Vec3>::new().try_reserve(usize::MAX).unwrap_err());
+            return Err(crate::reserve::shortage());
         }
         reserve_total(&mut c.data, segments)?;
         c.data.resize(segments, Vec3::zeros());
@@ -130,8 +130,7 @@ impl DensityConstraint {
             SCRATCH.with_borrow_mut(|scratch| {
                 self.project_one(i as usize, x, nb, dp, &mut again, scratch)
             });
-        });
-        Ok(())
+        })
     }
 
     /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary

@@ -23,7 +23,9 @@ pub enum PfStatus {
     PF_ERROR_BUFFER_TOO_SMALL = 3,
     /// Memory could not be allocated: for particles, boundaries, meshes, or what the next
     /// steps need (buffers and neighbour lists reserved before the first step of a call, or
-    /// neighbour lists, grid and corrections that grow during a step).
+    /// what grows during a step: neighbour lists, grid, corrections, the body coupling, the
+    /// LDLᵀ factorisation). A step aborts for want of memory only in the thread pool's own
+    /// bookkeeping (a few hundred bytes).
     PF_ERROR_OUT_OF_MEMORY = 4,
     /// The library panicked (a bug); the world involved, if any, is now poisoned.
     PF_ERROR_PANIC = 5,

@@ -103,16 +103,18 @@ impl NeighborLists {
 }
 
 /// Runs `f(i, segment_i, &mut items[i])` in parallel over the CSR segments
-/// `data[offsets[i]..offsets[i + 1]]` together with one item per segment.
+/// `data[offsets[i]..offsets[i + 1]]` together with one item per segment. Errors, having
+/// run nothing, when memory for the list of blocks cannot be had.
 pub fn par_segments_zip_mut<T: Send, U: Send>(
     offsets: &[u32],
     data: &mut [T],
     items: &mut [U],
     f: impl Fn(usize, &mut [T], &mut U) + Sync,
-) {
+) -> Result<(), TryReserveError> {
     let n = offsets.len().saturating_sub(1);
     assert_eq!(items.len(), n, "one item per segment");
-    let mut pieces = Vec::with_capacity(n.div_ceil(BLOCK));
+    let mut pieces = Vec::new();
+    pieces.try_reserve_exact(n.div_ceil(BLOCK))?;
     let (mut rest, mut rest_items) = (data, items);
     for b in 0..n.div_ceil(BLOCK) {
         let (lo, hi) = (b * BLOCK, ((b + 1) * BLOCK).min(n));
@@ -130,6 +132,7 @@ pub fn par_segments_zip_mut<T: Send, U: Send>(
             f(i, &mut chunk[a..b], item);
         }
     });
+    Ok(())
 }
 
 /// Points by component (m): a structure of arrays, so that the distance tests of a cell's

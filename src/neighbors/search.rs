@@ -178,7 +178,10 @@ impl Block<'_> {
         // ranges of the cells, and (without `AVX512`) their points copied into one run that
         // every query of the cell tests in long loops.
         let mut cached: Option<[usize; 3]> = None;
-        let mut ranges: Vec<std::ops::Range<usize>> = Vec::with_capacity(27);
+        // At most the 27 cells around a query's, held on the stack: a search allocates
+        // nothing but its lists (fallibly).
+        let mut near: [std::ops::Range<usize>; 27] = std::array::from_fn(|_| 0..0);
+        let mut ranges = 0;
         // The number of points in `ranges`.
         let mut total = 0;
         // The thread's buffers for that run, kept from block to block (they only grow;
@@ -191,7 +194,7 @@ impl Block<'_> {
                 let c = grid.cell_of(q);
                 if cached != Some(c) {
                     cached = Some(c);
-                    ranges.clear();
+                    ranges = 0;
                     for z in c[2].saturating_sub(1)..=(c[2] + 1).min(grid.dims[2] - 1) {
                         for y in c[1].saturating_sub(1)..=(c[1] + 1).min(grid.dims[1] - 1) {
                             for x in c[0].saturating_sub(1)..=(c[0] + 1).min(grid.dims[0] - 1) {
@@ -200,31 +203,35 @@ impl Block<'_> {
                                 let (start, end) = (cells[rank] as usize, cells[rank + 1] as usize);
                                 // Empty cells are left out (most cells of the boundary's table).
                                 if start < end {
-                                    ranges.push(start..end);
+                                    near[ranges] = start..end;
+                                    ranges += 1;
                                 }
                             }
                         }
                     }
-                    ranges.sort_unstable_by_key(|r| r.start);
-                    total = ranges.iter().map(|r| r.len()).sum();
+                    near[..ranges].sort_unstable_by_key(|r| r.start);
+                    total = near[..ranges].iter().map(|r| r.len()).sum();
                     if AVX512 {
                         // Tested where they lie: cells adjacent in Z-order make one run.
-                        ranges.dedup_by(|next, run| {
-                            let adjacent = run.end == next.start;
-                            if adjacent {
-                                run.end = next.end;
+                        let mut runs = 0;
+                        for i in 0..ranges {
+                            if runs > 0 && near[runs - 1].end == near[i].start {
+                                near[runs - 1].end = near[i].end;
+                            } else {
+                                near[runs] = near[i].clone();
+                                runs += 1;
                             }
-                            adjacent
-                        });
+                        }
+                        ranges = runs;
                     } else {
-                        if let Err(e) = candidates.copy_ranges(p, &ranges, total) {
+                        if let Err(e) = candidates.copy_ranges(p, &near[..ranges], total) {
                             break 'search Err(e);
                         }
                         ids.clear();
                         if let Err(e) = reserve_total(&mut ids, total) {
                             break 'search Err(e);
                         }
-                        for r in &ranges {
+                        for r in &near[..ranges] {
                             ids.extend(r.start as u32..r.end as u32);
                         }
                     }
@@ -237,10 +244,11 @@ impl Block<'_> {
                 #[cfg(target_arch = "x86_64")]
                 if AVX512 {
                     let own = self.exclude_self.map(|first| first + k);
+                    let ranges = &near[..ranges];
                     // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the
                     // processor has AVX-512; the ranges lie within the table's points, and
                     // `found` has room for their `total` points and one vector more.
-                    unsafe { push_within_avx512::<SPARSE>(q, p, &ranges, own, self.r2, found) };
+                    unsafe { push_within_avx512::<SPARSE>(q, p, ranges, own, self.r2, found) };
                     starts.push(found.len() as u32);
                     continue;
                 }

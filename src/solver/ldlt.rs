@@ -4,37 +4,46 @@
 //! [`GlobalSolver::prepare`] assembles Â through [`SystemMatrix::assemble`] and factorises it
 //! (symbolic and numeric) once per time step; every [`GlobalSolver::solve`] then reuses the
 //! factors for the three right-hand sides (one per coordinate). A matrix that offers no assembly,
-//! or whose factorisation fails, is solved by converged conjugate gradients instead
+//! or whose factorisation fails numerically, is solved by converged conjugate gradients instead
 //! ([`Cg::converged`]), so the solver never panics on a valid system.
+//!
+//! The assembly, the factors' values, the right-hand sides and the working memory of the
+//! numeric factorisation and the solves are kept from step to step and grown fallibly; the
+//! symbolic factorisation allocates its own arrays, fallibly. A shortage of memory is an
+//! error of `prepare` (the step fails and is undone), never an abort or a silent change of
+//! solver.
 
-use super::{Cg, GlobalSolver, SystemMatrix};
+use super::{Cg, Csr, GlobalSolver, SystemMatrix};
 use crate::Vec3;
-use faer::dyn_stack::{MemBuffer, MemStack};
+use crate::reserve::{reserve_total, shortage};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::ldlt::factor::LdltRegularization;
 use faer::sparse::linalg::cholesky::{
     LdltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
-use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
+use faer::sparse::{FaerError, SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, Mat, Par, Side};
-
-/// The factors of one time step.
-struct Factors {
-    symbolic: SymbolicCholesky<u32>,
-    values: Vec<f64>,
-}
+use std::collections::TryReserveError;
 
 /// Sparse LDLᵀ: factorise once per time step, one exact solve per outer iteration.
 pub struct Ldlt {
-    factors: Option<Factors>,
+    /// The symbolic factorisation of this step's Â, when it has factors (else: CG).
+    symbolic: Option<SymbolicCholesky<u32>>,
+    /// The values of the factors L and D.
+    values: Vec<f64>,
+    /// Â as assembled.
+    assembled: Csr,
     fallback: Cg,
+    /// The three right-hand sides, solved in place.
     rhs: Mat<f64>,
+    /// Working memory of the numeric factorisation and of the solves.
     scratch: MemBuffer,
 }
 
 impl std::fmt::Debug for Ldlt {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         f.debug_struct("Ldlt")
-            .field("factorised", &self.factors.is_some())
+            .field("factorised", &self.symbolic.is_some())
             .finish_non_exhaustive()
     }
 }
@@ -49,79 +58,104 @@ impl Ldlt {
     /// A solver with no factors yet (call [`GlobalSolver::prepare`] first).
     pub fn new() -> Self {
         Self {
-            factors: None,
+            symbolic: None,
+            values: Vec::new(),
+            assembled: Csr::default(),
             fallback: Cg::converged(),
             rhs: Mat::zeros(0, 3),
-            scratch: MemBuffer::new(faer::dyn_stack::StackReq::EMPTY),
+            scratch: MemBuffer::new(StackReq::EMPTY),
         }
     }
 
     /// Whether the last [`GlobalSolver::prepare`] produced factors (false: CG fallback).
     pub fn is_factorised(&self) -> bool {
-        self.factors.is_some()
+        self.symbolic.is_some()
     }
 
-    fn factorise(matrix: &dyn SystemMatrix) -> Option<Factors> {
-        let (offsets, cols, values) = matrix.assemble()?;
-        let n = offsets.len().checked_sub(1)?;
-        if cols.len() != values.len() || offsets[n] as usize != cols.len() {
-            return None;
+    /// Factorises `matrix` into `self.symbolic` and `self.values`; false when it cannot be
+    /// (no assembly, an invalid one, a numerical failure), an error when memory cannot be had.
+    fn factorise(&mut self, matrix: &dyn SystemMatrix) -> Result<bool, TryReserveError> {
+        if !matrix.assemble(&mut self.assembled)? {
+            return Ok(false);
+        }
+        let Csr {
+            offsets,
+            columns,
+            values,
+        } = &self.assembled;
+        let Some(n) = offsets.len().checked_sub(1) else {
+            return Ok(false);
+        };
+        if columns.len() != values.len() || offsets[n] as usize != columns.len() {
+            return Ok(false);
         }
         // Â is symmetric, so its CSR arrays are also its CSC arrays.
-        let pattern = SymbolicSparseColMatRef::new_checked(n, n, &offsets, None, &cols);
-        let a = SparseColMatRef::new(pattern, &values);
-        let symbolic = factorize_symbolic_cholesky(
+        let pattern = SymbolicSparseColMatRef::new_checked(n, n, offsets, None, columns);
+        let a = SparseColMatRef::new(pattern, values);
+        let symbolic = match factorize_symbolic_cholesky(
             pattern,
             Side::Lower,
             SymmetricOrdering::Amd,
             Default::default(),
-        )
-        .ok()?;
-        let mut l_values = vec![0.0; symbolic.len_val()];
+        ) {
+            Ok(symbolic) => symbolic,
+            Err(FaerError::OutOfMemory) => return Err(shortage()),
+            Err(_) => return Ok(false),
+        };
         let par = Par::Seq;
-        let mut mem = MemBuffer::try_new(
+        let scratch = StackReq::or(
             symbolic.factorize_numeric_ldlt_scratch::<f64>(par, Default::default()),
-        )
-        .ok()?;
-        symbolic
-            .factorize_numeric_ldlt(
-                &mut l_values,
-                a,
-                Side::Lower,
-                LdltRegularization::default(),
-                par,
-                MemStack::new(&mut mem),
-                Default::default(),
-            )
-            .ok()?;
-        if !l_values.iter().all(|v| v.is_finite()) {
-            return None;
+            symbolic.solve_in_place_scratch::<f64>(3, par),
+        );
+        if !MemStack::new(&mut self.scratch).can_hold(scratch) {
+            self.scratch = MemBuffer::try_new(scratch).map_err(|_| shortage())?;
         }
-        Some(Factors {
-            symbolic,
-            values: l_values,
-        })
+        self.values.clear();
+        reserve_total(&mut self.values, symbolic.len_val())?;
+        self.values.resize(symbolic.len_val(), 0.0);
+        reserve_rhs(&mut self.rhs, n)?;
+        self.rhs.resize_with(n, 3, |_, _| 0.0);
+        let factorised = symbolic.factorize_numeric_ldlt(
+            &mut self.values,
+            a,
+            Side::Lower,
+            LdltRegularization::default(),
+            par,
+            MemStack::new(&mut self.scratch),
+            Default::default(),
+        );
+        if factorised.is_err() || !self.values.iter().all(|v| v.is_finite()) {
+            return Ok(false);
+        }
+        self.symbolic = Some(symbolic);
+        Ok(true)
     }
 }
 
+/// Makes room in `rhs` for the three right-hand sides of `rows` unknowns.
+fn reserve_rhs(rhs: &mut Mat<f64>, rows: usize) -> Result<(), TryReserveError> {
+    rhs.try_reserve(rows, 3).map_err(|_| shortage())
+}
+
 impl GlobalSolver for Ldlt {
-    fn prepare(&mut self, matrix: &dyn SystemMatrix) {
-        self.factors = Self::factorise(matrix);
-        if let Some(f) = &self.factors {
-            let n = f.symbolic.nrows();
-            if self.rhs.nrows() != n {
-                self.rhs = Mat::zeros(n, 3);
-            }
-            self.scratch = MemBuffer::new(f.symbolic.solve_in_place_scratch::<f64>(3, Par::Seq));
+    fn try_reserve(&mut self, unknowns: usize) -> Result<(), TryReserveError> {
+        // The assembly of a diagonal Â and its factors; larger ones grow in `prepare`.
+        self.assembled.try_reserve(unknowns, unknowns)?;
+        reserve_total(&mut self.values, unknowns)?;
+        reserve_rhs(&mut self.rhs, unknowns)
+    }
+
+    fn prepare(&mut self, matrix: &dyn SystemMatrix) -> Result<(), TryReserveError> {
+        self.symbolic = None;
+        if !self.factorise(matrix)? {
+            // The fallback's buffers, which a factorising solver does not hold.
+            self.fallback.try_reserve(matrix.diagonal().len())?;
         }
+        Ok(())
     }
 
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize {
-        let Some(f) = self
-            .factors
-            .as_ref()
-            .filter(|f| f.symbolic.nrows() == x.len())
-        else {
+        let Some(symbolic) = self.symbolic.as_ref().filter(|f| f.nrows() == x.len()) else {
             return self.fallback.solve(matrix, b, x);
         };
         for (i, b) in b.iter().enumerate() {
@@ -129,7 +163,7 @@ impl GlobalSolver for Ldlt {
                 self.rhs[(i, c)] = b[c];
             }
         }
-        LdltRef::new(&f.symbolic, &f.values).solve_in_place_with_conj(
+        LdltRef::new(symbolic, &self.values).solve_in_place_with_conj(
             Conj::No,
             self.rhs.as_mut(),
             Par::Seq,
@@ -155,7 +189,7 @@ mod tests {
         };
         let b = rhs(30);
         let mut solver = Ldlt::new();
-        solver.prepare(&sys);
+        solver.prepare(&sys).unwrap();
         assert!(solver.is_factorised());
         let mut x = vec![Vec3::repeat(3.0); 30];
         assert_eq!(solver.solve(&sys, &b, &mut x), 1);
@@ -174,7 +208,7 @@ mod tests {
             let sys = DenseSystem::ring(n, diag);
             let b = rhs(n);
             let mut solver = Ldlt::new();
-            solver.prepare(&sys);
+            solver.prepare(&sys).unwrap();
             assert!(solver.is_factorised());
             let exact = sys.exact(&b);
             // Two solves with the same factors (as in successive outer iterations).
@@ -206,7 +240,7 @@ mod tests {
         let sys = Unassembled(DenseSystem::ring(10, 4.0));
         let b = rhs(10);
         let mut solver = Ldlt::new();
-        solver.prepare(&sys);
+        solver.prepare(&sys).unwrap();
         assert!(!solver.is_factorised());
         let mut x = vec![Vec3::zeros(); 10];
         assert!(solver.solve(&sys, &b, &mut x) > 1);

@@ -15,7 +15,9 @@ pub use sweep::Sweep;
 
 use crate::Vec3;
 use crate::params::SolverKind;
+use crate::reserve::reserve_total;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// The matrix A of the global step, A = Â ⊗ I₃, seen by the solvers only through its action
 /// and its diagonal, so that formulations other than the diagonal one can be added.
@@ -24,11 +26,41 @@ pub trait SystemMatrix: Sync {
     fn apply(&self, x: &[Vec3], out: &mut [Vec3]);
     /// The diagonal of Â (kg).
     fn diagonal(&self) -> &[f64];
-    /// Â assembled as compressed sparse rows `(row offsets, column indices, values)`, each
-    /// row's columns ascending, for the direct solvers; `None` (the default) when the matrix
-    /// is only available through its action.
-    fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
-        None
+    /// Assembles Â into `out` for the direct solvers, reusing its storage, and returns true;
+    /// false (the default, `out` left as it was) when the matrix is only available through
+    /// its action. Errors when memory for the arrays cannot be had.
+    fn assemble(&self, _out: &mut Csr) -> Result<bool, TryReserveError> {
+        Ok(false)
+    }
+}
+
+/// A square matrix in compressed sparse rows, its storage kept from one assembly to the
+/// next.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Csr {
+    /// Where each row's entries start in `columns` and `values` (one more than rows).
+    pub offsets: Vec<u32>,
+    /// The column of each entry, ascending within a row.
+    pub columns: Vec<u32>,
+    /// The value of each entry.
+    pub values: Vec<f64>,
+}
+
+impl Csr {
+    /// Makes room for `rows` rows with `entries` entries in all; errors when the memory
+    /// cannot be had.
+    pub fn try_reserve(&mut self, rows: usize, entries: usize) -> Result<(), TryReserveError> {
+        reserve_total(&mut self.offsets, rows + 1)?;
+        reserve_total(&mut self.columns, entries)?;
+        reserve_total(&mut self.values, entries)
+    }
+
+    /// Empties the matrix, keeping its storage, and makes room as [`Csr::try_reserve`].
+    pub fn try_reset(&mut self, rows: usize, entries: usize) -> Result<(), TryReserveError> {
+        self.offsets.clear();
+        self.columns.clear();
+        self.values.clear();
+        self.try_reserve(rows, entries)
     }
 }
 
@@ -50,9 +82,15 @@ impl SystemMatrix for DiagonalSystem {
         &self.diagonal
     }
 
-    fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
-        let n = u32::try_from(self.diagonal.len()).ok()?;
-        Some(((0..=n).collect(), (0..n).collect(), self.diagonal.clone()))
+    fn assemble(&self, out: &mut Csr) -> Result<bool, TryReserveError> {
+        let Ok(n) = u32::try_from(self.diagonal.len()) else {
+            return Ok(false);
+        };
+        out.try_reset(self.diagonal.len(), self.diagonal.len())?;
+        out.offsets.extend(0..=n);
+        out.columns.extend(0..n);
+        out.values.extend_from_slice(&self.diagonal);
+        Ok(true)
     }
 }
 
@@ -61,11 +99,15 @@ pub trait GlobalSolver: Send + Sync {
     /// Reserves the solver's buffers for systems of `unknowns` particles, so that the steps
     /// of a run allocate none of them; errors when the memory cannot be had. The default
     /// reserves nothing.
-    fn try_reserve(&mut self, _unknowns: usize) -> Result<(), std::collections::TryReserveError> {
+    fn try_reserve(&mut self, _unknowns: usize) -> Result<(), TryReserveError> {
         Ok(())
     }
-    /// Called once per time step, after A changed and before the first solve.
-    fn prepare(&mut self, _matrix: &dyn SystemMatrix) {}
+    /// Called once per time step, after A changed and before the first solve; errors when
+    /// memory the solver needs for this matrix (a factorisation) cannot be had, leaving the
+    /// solver to be prepared again. The default does nothing.
+    fn prepare(&mut self, _matrix: &dyn SystemMatrix) -> Result<(), TryReserveError> {
+        Ok(())
+    }
     /// Solves A·x = b with `x` holding the warm start; returns the inner iterations used.
     fn solve(&mut self, matrix: &dyn SystemMatrix, b: &[Vec3], x: &mut [Vec3]) -> usize;
     /// True when every solve is exactly one Jacobi sweep x ← x + D⁻¹(b − Ax), which on a
@@ -153,19 +195,20 @@ pub(crate) mod tests {
         fn diagonal(&self) -> &[f64] {
             &self.diag
         }
-        fn assemble(&self) -> Option<(Vec<u32>, Vec<u32>, Vec<f64>)> {
-            let (mut offsets, mut cols, mut values) = (vec![0], Vec::new(), Vec::new());
+        fn assemble(&self, out: &mut Csr) -> Result<bool, TryReserveError> {
+            out.try_reset(self.n, self.n * self.n)?;
+            out.offsets.push(0);
             for i in 0..self.n {
                 for j in 0..self.n {
                     let a = self.a[i * self.n + j];
                     if a != 0.0 {
-                        cols.push(j as u32);
-                        values.push(a);
+                        out.columns.push(j as u32);
+                        out.values.push(a);
                     }
                 }
-                offsets.push(cols.len() as u32);
+                out.offsets.push(out.columns.len() as u32);
             }
-            Some((offsets, cols, values))
+            Ok(true)
         }
     }
 
@@ -183,9 +226,13 @@ pub(crate) mod tests {
         let mut out = vec![Vec3::zeros(); 2];
         sys.apply(&[Vec3::repeat(1.0), Vec3::new(1.0, 2.0, 3.0)], &mut out);
         assert_eq!(out, vec![Vec3::repeat(2.0), Vec3::new(3.0, 6.0, 9.0)]);
-        assert_eq!(
-            sys.assemble(),
-            Some((vec![0, 1, 2], vec![0, 1], vec![2.0, 3.0]))
-        );
+        let mut csr = Csr::default();
+        assert_eq!(sys.assemble(&mut csr), Ok(true));
+        let expected = Csr {
+            offsets: vec![0, 1, 2],
+            columns: vec![0, 1],
+            values: vec![2.0, 3.0],
+        };
+        assert_eq!(csr, expected);
     }
 }

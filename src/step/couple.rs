@@ -15,14 +15,18 @@
 //! K = −(m/Δt²) Σ_j (x_j − s_j).
 //!
 //! Slots are listed in particle order and summed in blocks of fixed size in block order, so
-//! the loads do not depend on the thread count.
+//! the loads do not depend on the thread count. Their storage is kept from step to step and
+//! grown fallibly as a step starts, so that a step short of memory for it fails before it
+//! moves the fluid (docs/method.md §1.3).
 
 use crate::Vec3;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Projection};
 use crate::neighbors::{NeighborLists, PointsByComponent};
+use crate::reserve::reserve_total;
 use crate::solver::Chebyshev;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// Slots per block of the final reduction.
 const BLOCK: usize = 1024;
@@ -73,6 +77,13 @@ pub(crate) struct Coupling {
     next: Vec<Vec3>,
     /// The number of bodies.
     bodies: usize,
+    /// The number of slots of each fluid particle (scratch of [`Coupling::start`]).
+    counts: Vec<u32>,
+    /// Every block's sums of the bodies' loads (scratch of [`Coupling::loads`]).
+    partial: Vec<Load>,
+    /// Every block's sum of the fluid's exchanged momentum and moment (scratch of
+    /// [`Coupling::loads`]).
+    exchanged: Vec<Load>,
 }
 
 /// What one update of the shares reads: the local step's projections made at `x` = X^(k).
@@ -90,7 +101,9 @@ pub(super) struct Iterate<'a> {
 
 impl Coupling {
     /// Starts a step at the prediction `s` (m): one slot, set to zero, for every fluid
-    /// particle and every body with a boundary particle in its reach.
+    /// particle and every body with a boundary particle in its reach. Makes room for
+    /// everything the step's coupling and loads keep, reusing the last step's storage;
+    /// errors when that memory cannot be had (the caller undoes the step).
     pub fn start(
         &mut self,
         constraint: &DensityConstraint,
@@ -98,64 +111,87 @@ impl Coupling {
         boundary_lists: &NeighborLists,
         s: &[Vec3],
         bodies: usize,
-    ) {
+    ) -> Result<(), TryReserveError> {
         self.bodies = bodies;
+        let particles = boundary_lists.len();
         let owner_of = |k: u32| (boundary.owner[k as usize] as usize).min(bodies) as u32;
-        let slots: Vec<(u32, u32, Vec3, Vec3)> = (0..boundary_lists.len())
-            .into_par_iter()
-            .flat_map_iter(|j| {
+        // Most particles near a boundary touch only walls: they get no slot (the walls' load
+        // is what the bodies leave of the fluid's momentum balance).
+        self.counts.clear();
+        reserve_total(&mut self.counts, particles)?;
+        self.counts.resize(particles, 0);
+        self.counts
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(j, count)| {
+                *count = owners_near(boundary_lists.of(j), owner_of, bodies).count() as u32;
+            });
+        let slots: usize = self.counts.iter().map(|&c| c as usize).sum();
+        for v in [&mut self.particle, &mut self.owner] {
+            v.clear();
+            reserve_total(v, slots)?;
+        }
+        for v in [
+            &mut self.gradient,
+            &mut self.all,
+            &mut self.previous,
+            &mut self.current,
+            &mut self.next,
+        ] {
+            v.clear();
+            reserve_total(v, slots)?;
+        }
+        for v in [&mut self.keep, &mut self.gain] {
+            v.clear();
+            reserve_total(v, slots)?;
+        }
+        self.partial.clear();
+        reserve_total(&mut self.partial, slots.div_ceil(BLOCK) * bodies)?;
+        self.exchanged.clear();
+        reserve_total(&mut self.exchanged, particles.div_ceil(BLOCK))?;
+        // Slots in particle order; `owner` holds each slot's rank among its particle's
+        // bodies until the slot is filled.
+        for (j, &count) in self.counts.iter().enumerate() {
+            for rank in 0..count {
+                self.particle.push(j as u32);
+                self.owner.push(rank);
+            }
+        }
+        self.gradient.resize(slots, Vec3::zeros());
+        self.all.resize(slots, Vec3::zeros());
+        self.owner
+            .par_iter_mut()
+            .zip(self.gradient.par_iter_mut())
+            .zip(self.all.par_iter_mut())
+            .zip(self.particle.par_iter())
+            .for_each(|(((owner, g), all), &j)| {
+                let j = j as usize;
                 let near = boundary_lists.of(j);
-                // Most particles near a boundary touch only walls: they get no slot (the walls'
-                // load is what the bodies leave of the fluid's momentum balance).
-                let touches_body = |k: &u32| (owner_of(*k) as usize) < bodies;
-                if !near.iter().any(touches_body) {
-                    return Vec::new();
-                }
                 let gradient = |k: u32| {
                     let k = k as usize;
                     constraint.kernel.grad_w(&(s[j] - boundary.positions[k]))
                         * (boundary.psi[k] / constraint.rest_density)
                 };
-                let mut owners: Vec<u32> = near
+                let o = owners_near(near, owner_of, bodies)
+                    .nth(*owner as usize)
+                    .expect("every slot's rank is below its particle's count of bodies");
+                *owner = o;
+                *g = near
                     .iter()
-                    .filter(|k| touches_body(k))
-                    .map(|&k| owner_of(k))
-                    .collect();
-                owners.sort_unstable();
-                owners.dedup();
-                let all: Vec3 = near.iter().map(|&k| gradient(k)).sum();
-                owners
-                    .into_iter()
-                    .map(|o| {
-                        let g = near
-                            .iter()
-                            .filter(|&&k| owner_of(k) == o)
-                            .map(|&k| gradient(k))
-                            .sum();
-                        (j as u32, o, g, all)
-                    })
-                    .collect()
-            })
-            .collect();
-        self.particle.clear();
-        self.owner.clear();
-        self.gradient.clear();
-        self.all.clear();
-        for &(j, o, g, all) in &slots {
-            self.particle.push(j);
-            self.owner.push(o);
-            self.gradient.push(g);
-            self.all.push(all);
-        }
+                    .filter(|&&k| owner_of(k) == o)
+                    .map(|&k| gradient(k))
+                    .sum();
+                *all = near.iter().map(|&k| gradient(k)).sum();
+            });
         for u in [&mut self.previous, &mut self.current, &mut self.next] {
-            u.clear();
-            u.resize(slots.len(), Vec3::zeros());
+            u.resize(slots, Vec3::zeros());
         }
+        Ok(())
     }
 
     /// Takes the global step's coefficients Δt²k n_j/Â_jj and Δt²k w_j/Â_jj for every slot,
     /// once the step's system (`diagonal` Â_jj, kg) and projection `weights` are set up;
-    /// `dt2k` is Δt²k (kg).
+    /// `dt2k` is Δt²k (kg). Allocates nothing: [`Coupling::start`] made the room.
     pub(super) fn prepare(
         &mut self,
         constraint: &DensityConstraint,
@@ -200,7 +236,7 @@ impl Coupling {
     /// `out[bodies]` for the walls and obstacles, which take the rest of the momentum the
     /// fluid exchanged in the step, K = −(m/Δt²) Σ_j (x_j − s_j), and of its moment.
     pub fn loads(
-        &self,
+        &mut self,
         mass: f64,
         s: &PointsByComponent,
         x: &[Vec3],
@@ -209,28 +245,33 @@ impl Coupling {
     ) {
         let scale = -mass / (dt * dt);
         let bodies = self.bodies;
-        let partial: Vec<Vec<Load>> = self
-            .current
-            .par_chunks(BLOCK)
+        let (particle, owner) = (&self.particle, &self.owner);
+        // The room for the sums was made by `start` (and for `out` before the step).
+        self.partial.clear();
+        self.partial
+            .resize(self.current.len().div_ceil(BLOCK) * bodies, Load::default());
+        self.partial
+            .par_chunks_mut(bodies.max(1))
+            .zip(self.current.par_chunks(BLOCK))
             .enumerate()
-            .map(|(block, shares)| {
-                let mut sums = vec![Load::default(); bodies];
+            .for_each(|(block, (sums, shares))| {
                 for (slot, u) in (block * BLOCK..).zip(shares) {
                     let force = u * scale;
-                    let arm = x[self.particle[slot] as usize];
-                    sums[self.owner[slot] as usize].add(&Load {
+                    let arm = x[particle[slot] as usize];
+                    sums[owner[slot] as usize].add(&Load {
                         force,
                         moment: arm.cross(&force),
                     });
                 }
-                sums
-            })
-            .collect();
-        let exchanged: Vec<Load> = x
-            .par_chunks(BLOCK)
+            });
+        self.exchanged.clear();
+        self.exchanged
+            .resize(x.len().div_ceil(BLOCK), Load::default());
+        self.exchanged
+            .par_iter_mut()
+            .zip(x.par_chunks(BLOCK))
             .enumerate()
-            .map(|(block, xs)| {
-                let mut sum = Load::default();
+            .for_each(|(block, (sum, xs))| {
                 for (j, xj) in (block * BLOCK..).zip(xs) {
                     let force = (xj - s.at(j)) * scale;
                     sum.add(&Load {
@@ -238,18 +279,16 @@ impl Coupling {
                         moment: xj.cross(&force),
                     });
                 }
-                sum
-            })
-            .collect();
+            });
         out.clear();
         out.resize(bodies + 1, Load::default());
-        for sums in &partial {
+        for sums in self.partial.chunks(bodies.max(1)) {
             for (o, s) in out.iter_mut().zip(sums) {
                 o.add(s);
             }
         }
         let mut walls = Load::default();
-        for e in &exchanged {
+        for e in &self.exchanged {
             walls.add(e);
         }
         for body in &out[..bodies] {
@@ -258,6 +297,23 @@ impl Coupling {
         }
         out[bodies] = walls;
     }
+}
+
+/// The bodies (those below `bodies`; `owner_of` gives a boundary particle's owner, `bodies`
+/// for walls and obstacles) that own a particle of `near`, ascending, each once: one pass
+/// over `near` per body, and no storage.
+fn owners_near(
+    near: &[u32],
+    owner_of: impl Fn(u32) -> u32,
+    bodies: usize,
+) -> impl Iterator<Item = u32> {
+    let after = move |last: Option<u32>| {
+        near.iter()
+            .map(|&k| owner_of(k))
+            .filter(|&o| (o as usize) < bodies && last.is_none_or(|last| o > last))
+            .min()
+    };
+    std::iter::successors(after(None), move |&o| after(Some(o)))
 }
 
 impl Iterate<'_> {

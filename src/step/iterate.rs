@@ -53,8 +53,8 @@ pub(super) struct Outcome {
 
 /// Iterates until the density rule, the displacement rule or the iteration limit stops; the
 /// result X^(k) is left in `b.current`. Adds the local and global times to `timings`.
-/// Errors when a local step needs more memory for its kept corrections than can be had
-/// (the caller undoes the step).
+/// Errors when the solver's factorisation or a local step's kept corrections need more
+/// memory than can be had (the caller undoes the step).
 pub(super) fn iterate(
     it: Iteration,
     b: &mut StepBuffers,
@@ -79,7 +79,7 @@ pub(super) fn iterate(
         .par_iter_mut()
         .enumerate()
         .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
-    solver.prepare(&b.system);
+    solver.prepare(&b.system)?;
 
     b.previous.clone_from(&b.current);
     constraint.weights(&b.fluid_lists, &mut b.weights);

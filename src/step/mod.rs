@@ -6,8 +6,8 @@
 //! [`next_step_size`] chooses the next Δt by the CFL rule (docs/method.md §8).
 //!
 //! A step that runs out of memory for what only it can size — neighbour lists beyond their
-//! reservation, a rebuilt grid, kept corrections — fails before it moves the fluid, and
-//! puts back what it changed until then ([`undo`]).
+//! reservation, a rebuilt grid, kept corrections, the body coupling's slots, a factorisation
+//! — fails before it moves the fluid, and puts back what it changed until then ([`undo`]).
 
 mod couple;
 mod finish;
@@ -97,8 +97,9 @@ pub(crate) struct StepContext<'a> {
 /// Advances the fluid by one step of `dt` seconds (positive, finite, checked by the
 /// caller) and returns what the step did with the size the next step should take (s).
 /// Errors when the step needs more memory than can be had (for neighbour lists, a rebuilt
-/// grid, the boundary's sort, kept corrections), having changed nothing: the fluid moves
-/// only once the step can no longer fail, and the rest is put back.
+/// grid, the boundary's sort, kept corrections, the body coupling, the solver's
+/// factorisation), having changed nothing: the fluid moves only once the step can no longer
+/// fail, and the rest is put back.
 pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), TryReserveError> {
     let started = Instant::now();
     let StepContext {
@@ -140,7 +141,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 &buffers.boundary_lists,
                 &buffers.current,
                 bodies.len(),
-            );
+            )?;
         }
         iterate::iterate(
             iterate::Iteration {

@@ -19,10 +19,11 @@ impl StepBuffers {
     /// where sizes are known (docs/method.md §1.3): every per-particle buffer, the scratch of
     /// the sort, the fluid neighbour lists for about `per_query` neighbours per particle (or
     /// what each block held last time, with a quarter more), the boundary lists' blocks, δ_k
-    /// for `iterations` outer iterations, and room to keep the state of `bodies` bodies and
-    /// `emitters` emitters for an undo. What cannot be known before a step — more
-    /// neighbours than that, the segments of kept corrections, a rebuilt grid — grows during
-    /// it through fallible reservations, and a step that cannot have it is undone.
+    /// for `iterations` outer iterations, the loads on `bodies` bodies and the walls, and room
+    /// to keep the state of `bodies` bodies and `emitters` emitters for an undo. What cannot
+    /// be known before a step — more neighbours than that, the segments of kept corrections,
+    /// a rebuilt grid, the slots of the body coupling — grows during it through fallible
+    /// reservations, and a step that cannot have it is undone.
     pub(crate) fn try_reserve(
         &mut self,
         fluid: usize,
@@ -50,6 +51,9 @@ impl StepBuffers {
         self.corrections.try_reserve(fluid)?;
         self.fluid_lists.try_reserve(fluid, per_query)?;
         self.boundary_lists.try_reserve(fluid, 0)?;
+        if bodies > 0 {
+            reserve_total(&mut self.loads, bodies + 1)?;
+        }
         self.undo.try_reserve(bodies, iterations, emitters)
     }
 

@@ -2,8 +2,8 @@
 //! (at its end, docs/method.md §1.3) it changes only the fluid its emitters insert, the
 //! bodies' poses, the neighbour grid when it rebuilds it, the boundary when it sorts or
 //! places it anew, and the record of the outer iterations; each is kept here before it
-//! changes, so that a step that cannot have the memory its neighbour lists, grid or local
-//! steps need leaves the world as it was.
+//! changes, so that a step that cannot have the memory its neighbour lists, grid, local
+//! steps, body coupling or factorisation need leaves the world as it was.
 
 use super::SearchGrid;
 use crate::body::{Body, BodyState};

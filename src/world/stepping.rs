@@ -5,9 +5,9 @@
 //! A call either succeeds or changes nothing: everything that can fail — the sizes, the
 //! presence of fluid, the particle limit over the emitters' output, the memory the steps
 //! need as far as it can be known — is checked before the first step. What only a step
-//! can size (neighbour lists beyond their reservation, a rebuilt grid, kept corrections)
-//! it reserves fallibly; a step that cannot have it is undone, and a run of steps ends
-//! there with the steps before it kept.
+//! can size (neighbour lists beyond their reservation, a rebuilt grid, kept corrections,
+//! the body coupling, the LDLᵀ factorisation) it reserves fallibly; a step that cannot have
+//! it is undone, and a run of steps ends there with the steps before it kept.
 
 use super::World;
 use crate::Error;
@@ -45,8 +45,9 @@ impl World {
     /// Errors, changing nothing: a bad `dt` (or one so short that the clock, at the current
     /// time, would not move), no fluid, emitters that would exceed the particle limit, or
     /// ([`Error::OutOfMemory`]) too little memory for the step — for its buffers, or for
-    /// neighbour lists, a grid or corrections that grow during it (a fluid compressed far
-    /// beyond rest, e.g. particles placed on top of each other, needs many more neighbours).
+    /// neighbour lists, a grid, corrections, the body coupling or the LDLᵀ factorisation
+    /// that grow during it (a fluid compressed far beyond rest, e.g. particles placed on top
+    /// of each other, needs many more neighbours).
     pub fn step_with_dt(&mut self, dt: f64) -> Result<&StepStats, Error> {
         check_step("dt", dt)?;
         if self.time + dt == self.time {
@@ -114,7 +115,7 @@ impl World {
     /// Errors ([`Error::OutOfMemory`]) when the step needs more memory than can be had,
     /// having changed nothing.
     fn take_prepared_step(&mut self, dt: f64) -> Result<&StepStats, Error> {
-        let oom = |_| Error::out_of_memory("the neighbour lists and corrections of a time step");
+        let oom = |_| Error::out_of_memory("the working storage of a time step");
         self.buffers
             .undo
             .before_emission(&self.fluid, &self.emitters);

@@ -13,8 +13,10 @@ use crate::ffi::status::{Failure, PfStatus, status_call};
 /// emitters that would exceed the particle limit), `PF_ERROR_OUT_OF_MEMORY` (the step's
 /// buffers and neighbour lists, reserved before it starts, or what only the step can size
 /// and grows during it: neighbour lists of a fluid compressed far beyond rest, a rebuilt
-/// neighbour grid, the corrections its projections keep). On any error the world is
-/// unchanged.
+/// neighbour grid, the corrections its projections keep, the coupling of the fluid to
+/// bodies, the LDLᵀ factorisation). On any error the world is unchanged. A step does not
+/// abort for want of memory, short of the thread pool's own bookkeeping (a few hundred
+/// bytes).
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.

@@ -1,11 +1,12 @@
-//! `projfluid validate`: the Martin & Moyce dam break against the 1952 measurements, and a
-//! tank at rest against hydrostatics. Prints a table and writes CSV and PNG files.
+//! `projfluid validate`: the Martin & Moyce dam break against the 1952 measurements, the
+//! MARIN dam break past a box against Kleefsman et al. (2005), and a tank at rest against
+//! hydrostatics. Prints a table and writes CSV and PNG files.
 
 use crate::{Failure, solver_parser};
 use clap::{Args, Subcommand};
 use projfluid::{Error, SolverKind};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, martin_moyce};
+use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -16,6 +17,9 @@ pub(crate) enum ValidateCommand {
     /// Column collapse (Martin & Moyce 1952): surge front and residual height against the
     /// measurements.
     MartinMoyce(MartinMoyceArgs),
+    /// Dam break past a box (Kleefsman et al. 2005, SPHERIC Test 2): water heights at the four
+    /// gauges against the measurements.
+    Kleefsman(KleefsmanArgs),
     /// A tank of water at rest: compression, residual motion, height and pressure profile.
     Hydrostatic(HydrostaticArgs),
 }
@@ -49,6 +53,51 @@ pub(crate) struct MartinMoyceArgs {
     /// Dimensionless duration tau = t·√(g/a) [default: 3.0 for n² = 2, 3.5 for n² = 1].
     #[arg(long, value_name = "TAU", allow_negative_numbers = true)]
     duration: Option<f64>,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
+/// Options of `projfluid validate kleefsman`.
+#[derive(Args)]
+pub(crate) struct KleefsmanArgs {
+    /// Particle radius r in metres (0.004–0.05); the lattice spacing is 2r.
+    #[arg(
+        long,
+        value_name = "METRES",
+        default_value_t = 0.0125,
+        allow_negative_numbers = true
+    )]
+    radius: f64,
+    /// Simulated time in seconds.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 2.0,
+        allow_negative_numbers = true
+    )]
+    duration: f64,
+    /// Leave the box out (a check that the comparison sees it).
+    #[arg(long)]
+    no_obstacle: bool,
+    /// Magnitude of gravity in m/s².
+    #[arg(
+        long,
+        value_name = "M/S2",
+        default_value_t = 9.81,
+        allow_negative_numbers = true
+    )]
+    gravity: f64,
+    /// XSPH viscosity coefficient, in [0, 1] (0 = off).
+    #[arg(
+        long,
+        value_name = "C",
+        default_value_t = 0.01,
+        allow_negative_numbers = true
+    )]
+    viscosity: f64,
+    /// Outer stopping threshold τ in metres [default: 3e-3·r].
+    #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
+    tau: Option<f64>,
     #[command(flatten)]
     common: CommonArgs,
 }
@@ -107,6 +156,7 @@ pub(crate) struct HydrostaticArgs {
 pub(crate) fn validate(command: &ValidateCommand) -> Result<(), Failure> {
     match command {
         ValidateCommand::MartinMoyce(args) => martin_moyce(args),
+        ValidateCommand::Kleefsman(args) => kleefsman(args),
         ValidateCommand::Hydrostatic(args) => hydrostatic(args),
     }
 }
@@ -191,6 +241,84 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
         files.comparison_csv.display(),
         files.front_png.display(),
         files.height_png.display()
+    );
+    print(&text)
+}
+
+/// An invalid field of a setup as the option that sets it.
+fn option_error(e: Error) -> Failure {
+    match e {
+        Error::InvalidArgument { field, message } => {
+            Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
+        }
+        other => input(other),
+    }
+}
+
+fn kleefsman(args: &KleefsmanArgs) -> Result<(), Failure> {
+    let setup = kleefsman::Setup {
+        particle_radius: args.radius,
+        duration: args.duration,
+        obstacle: !args.no_obstacle,
+        gravity: args.gravity,
+        viscosity: args.viscosity,
+        tolerance: args.tau,
+        solver: args.common.solver,
+        threads: args.common.threads,
+    };
+    setup.validate().map_err(option_error)?;
+    let data = kleefsman::Measurements::load().map_err(runtime)?;
+    create_dir(&args.common.out)?;
+    let [nx, ny, nz] = setup.fluid_count();
+    eprintln!(
+        "kleefsman: r = {} m, {nx} x {ny} x {nz} fluid particles, {}, g = {} m/s², viscosity {}, \
+         {} s, {} solver",
+        setup.particle_radius,
+        if setup.obstacle {
+            "with the box"
+        } else {
+            "no box"
+        },
+        setup.gravity,
+        setup.viscosity,
+        setup.duration,
+        setup.solver.name()
+    );
+    let clock = Instant::now();
+    let run = kleefsman::simulate(&setup, |_| {}).map_err(runtime)?;
+    let cmp = kleefsman::compare(&run, &data, kleefsman::Tolerances::default());
+    let files = kleefsman::write_report(&args.common.out, &run, &data, &cmp).map_err(runtime)?;
+    let mut text = format!(
+        "{} fluid particles, {} boundary particles, {} steps ({:.2} outer iterations per step) \
+         in {:.1} s; max compression {:.3} %, {} escaped\n\n",
+        run.particles,
+        run.boundary_particles,
+        run.steps,
+        run.outer_iterations as f64 / run.steps.max(1) as f64,
+        clock.elapsed().as_secs_f64(),
+        100.0 * run.density_error_max,
+        run.escaped
+    );
+    text += &cmp.table();
+    let failures = cmp.failures();
+    if failures.is_empty() {
+        text += "\nevery compared quantity the run covers is within its tolerance\n";
+    } else {
+        text += &format!("\n{} outside the tolerance:\n", failures.len());
+        for f in &failures {
+            text += &format!("  {f}\n");
+        }
+    }
+    let charts: Vec<String> = files
+        .charts
+        .iter()
+        .map(|p| p.display().to_string())
+        .collect();
+    text += &format!(
+        "wrote {}, {}, {}\n",
+        files.series_csv.display(),
+        files.comparison_csv.display(),
+        charts.join(", ")
     );
     print(&text)
 }

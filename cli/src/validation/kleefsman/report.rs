@@ -1,0 +1,178 @@
+//! The dam break's report: the comparison as a table, the gauge history and the comparison as
+//! CSV, and one chart per gauge as PNG.
+
+use super::compare::Verdict;
+use super::{Comparison, GAUGE_X, GAUGES, Measurements, Run};
+use crate::plot::{LineChart, Series, SeriesStyle};
+use crate::validation::write_text;
+use projfluid::Error;
+use std::fmt::Write;
+use std::path::{Path, PathBuf};
+
+fn mark(v: Verdict) -> &'static str {
+    match v {
+        Verdict::Pass => "ok",
+        Verdict::Fail => "FAIL",
+        Verdict::NotCovered => "not reached",
+    }
+}
+
+impl Comparison {
+    /// The comparison as a plain-text table.
+    pub fn table(&self) -> String {
+        let t = self.tolerances;
+        let mut out = format!(
+            "surge arrival (first height >= {} m): within {} s at H3 and H2, from {} s early to \
+             {} s late at H1 (in the box's lee)\n",
+            super::ARRIVAL_LEVEL,
+            t.arrival,
+            t.lee_early,
+            t.lee_late
+        );
+        let _ = writeln!(
+            out,
+            "{:>5}  {:>7}  {:>9}  {:>9}  {:>8}",
+            "gauge", "x (m)", "sim (s)", "meas (s)", "delay"
+        );
+        for a in &self.arrivals {
+            let sim = a.simulated.map_or("-".into(), |s| format!("{s:.3}"));
+            let delay = a.delay().map_or("-".into(), |d| format!("{d:+.3}"));
+            let _ = writeln!(
+                out,
+                "{:>5}  {:>7.3}  {sim:>9}  {:>9.3}  {delay:>8}  {}",
+                GAUGES[a.gauge],
+                GAUGE_X[a.gauge],
+                a.measured,
+                mark(a.verdict(t.arrival_window(a.gauge)))
+            );
+        }
+        let _ = writeln!(
+            out,
+            "\nreservoir height at H4 (x = 2.638 m), tolerance {} m",
+            t.reservoir
+        );
+        let _ = writeln!(
+            out,
+            "{:>6}  {:>9}  {:>10}  {:>8}",
+            "t (s)", "sim (m)", "meas (m)", "error"
+        );
+        for l in &self.reservoir {
+            let sim = l.simulated.map_or("-".into(), |s| format!("{s:.3}"));
+            let err = l
+                .simulated
+                .map_or("-".into(), |s| format!("{:+.3}", s - l.measured));
+            let _ = writeln!(
+                out,
+                "{:>6.2}  {sim:>9}  {:>10.3}  {err:>8}  {}",
+                l.time,
+                l.measured,
+                mark(l.verdict(t.reservoir))
+            );
+        }
+        let _ = writeln!(out, "\nRMS height difference over the run (m)");
+        for (g, rms) in self.rms.iter().enumerate() {
+            let _ = writeln!(out, "{:>5}  {:>7.3}  {rms:.4}", GAUGES[g], GAUGE_X[g]);
+        }
+        out
+    }
+
+    /// CSV of every compared quantity: kind, gauge, time or level, measured, simulated
+    /// (empty when not reached), verdict.
+    pub fn csv(&self) -> String {
+        let t = self.tolerances;
+        let mut out = String::from("quantity,gauge,measured,simulated,verdict\n");
+        for a in &self.arrivals {
+            let sim = a.simulated.map_or(String::new(), |s| format!("{s}"));
+            let _ = writeln!(
+                out,
+                "arrival_s,{},{},{sim},{}",
+                GAUGES[a.gauge],
+                a.measured,
+                mark(a.verdict(t.arrival_window(a.gauge)))
+            );
+        }
+        for l in &self.reservoir {
+            let sim = l.simulated.map_or(String::new(), |s| format!("{s}"));
+            let _ = writeln!(
+                out,
+                "height_m_at_{}s,H4,{},{sim},{}",
+                l.time,
+                l.measured,
+                mark(l.verdict(t.reservoir))
+            );
+        }
+        for (g, rms) in self.rms.iter().enumerate() {
+            let _ = writeln!(out, "rms_m,{},0,{rms},", GAUGES[g]);
+        }
+        out
+    }
+}
+
+/// The files [`write_report`] writes.
+#[derive(Clone, Debug)]
+pub struct ReportFiles {
+    /// Gauge history: t, H1..H4 per reading.
+    pub series_csv: PathBuf,
+    /// The comparison.
+    pub comparison_csv: PathBuf,
+    /// One chart per gauge, H1..H4.
+    pub charts: Vec<PathBuf>,
+}
+
+/// Writes the gauge history and the comparison as CSV and a chart per gauge as PNG into
+/// `dir` (which must exist), named `kleefsman_*`.
+pub fn write_report(
+    dir: &Path,
+    run: &Run,
+    data: &Measurements,
+    cmp: &Comparison,
+) -> Result<ReportFiles, Error> {
+    let files = ReportFiles {
+        series_csv: dir.join("kleefsman_series.csv"),
+        comparison_csv: dir.join("kleefsman_comparison.csv"),
+        charts: GAUGES
+            .iter()
+            .map(|g| dir.join(format!("kleefsman_{g}.png")))
+            .collect(),
+    };
+    let mut series = String::from("t_s,H1_m,H2_m,H3_m,H4_m\n");
+    for s in &run.samples {
+        let [a, b, c, d] = s.heights;
+        let _ = writeln!(series, "{},{a},{b},{c},{d}", s.time);
+    }
+    write_text(&files.series_csv, &series)?;
+    write_text(&files.comparison_csv, &cmp.csv())?;
+    let end = run.end();
+    let what = if run.setup.obstacle {
+        String::new()
+    } else {
+        ", no box".to_string()
+    };
+    for (g, path) in files.charts.iter().enumerate() {
+        let measured: Vec<(f64, f64)> = data.heights[g]
+            .iter()
+            .copied()
+            .filter(|p| p.0 <= end)
+            .collect();
+        let mut chart_series = vec![Series {
+            label: format!("simulation, r = {} m{what}", run.setup.particle_radius),
+            points: run.heights(g),
+            style: SeriesStyle::Line,
+        }];
+        if !measured.is_empty() {
+            chart_series.push(Series {
+                label: "measured (Kleefsman et al. 2005)".into(),
+                points: measured,
+                style: SeriesStyle::Line,
+            });
+        }
+        LineChart {
+            title: format!("Water height at {} (x = {} m)", GAUGES[g], GAUGE_X[g]),
+            x_label: "t (s)".into(),
+            y_label: "height (m)".into(),
+            series: chart_series,
+        }
+        .write_png(path)?;
+    }
+    Ok(files)
+}

@@ -1,0 +1,177 @@
+//! Validation against the MARIN dam break with a box (Kleefsman et al. 2005, SPHERIC Test 2)
+//! at a coarse resolution, its discrimination (a broken gravity or a missing box must fail it),
+//! the shipped scene, and `projfluid validate kleefsman`.
+
+use projfluid::scene::Scene;
+use projfluid_lab::validation::kleefsman::{
+    self, Comparison, LEE_GAUGE, Measurements, Run, Setup, Tolerances, Verdict,
+};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// Particle radius of the tests (m): d = 5 cm, 11 particles over the depth, 5,500 in all (the
+/// command's default is 12.5 mm).
+const TEST_RADIUS: f64 = 0.025;
+
+/// The dam break at the test resolution with `change` applied to the default setup, run for
+/// `duration` seconds and compared with the measurements at the default tolerances.
+fn dam_break(duration: f64, change: impl FnOnce(&mut Setup)) -> (Run, Comparison) {
+    let mut setup = Setup {
+        particle_radius: TEST_RADIUS,
+        duration,
+        ..Setup::default()
+    };
+    change(&mut setup);
+    let run = kleefsman::simulate(&setup, |_| {}).expect("dam break runs");
+    let data = Measurements::load().unwrap();
+    let cmp = kleefsman::compare(&run, &data, Tolerances::default());
+    (run, cmp)
+}
+
+/// With the experiment's gravity and box, over the first 2 s: the surge reaches H3, H2 and H1
+/// (behind the box) within the arrival tolerance of the measured times, and the reservoir's
+/// height at H4 lies within the height tolerance at every compared time. No particle escapes
+/// and the compression stays small.
+///
+/// The same comparison must fail with gravity scaled by 0.8 (every arrival late, the
+/// reservoir falls too slowly), and without the box (the surge reaches H1, in the box's lee,
+/// about 0.4 s early; 1 s of flow decides it).
+#[test]
+fn dam_break_past_a_box_matches_kleefsman_and_discriminates() {
+    let (run, cmp) = dam_break(2.0, |_| {});
+    assert_eq!(run.escaped, 0);
+    assert!(
+        run.density_error_max < 0.02,
+        "compression {}",
+        run.density_error_max
+    );
+    assert!(cmp.covered(), "{}", cmp.table());
+    assert!(
+        cmp.failures().is_empty(),
+        "{}\n{:#?}",
+        cmp.table(),
+        cmp.failures()
+    );
+
+    let (_, weak) = dam_break(2.0, |s| s.gravity *= 0.8);
+    assert!(
+        !weak.failures().is_empty(),
+        "gravity x 0.8 must fail:\n{}",
+        weak.table()
+    );
+    // Weaker gravity: every arrival later than with g, and the reservoir outside its
+    // tolerance (too high) at some compared time.
+    for (a, w) in cmp.arrivals.iter().zip(&weak.arrivals) {
+        assert!(
+            w.simulated.unwrap_or(f64::INFINITY) > a.simulated.unwrap(),
+            "{}\n{}",
+            cmp.table(),
+            weak.table()
+        );
+    }
+    let tol = weak.tolerances.reservoir;
+    assert!(
+        weak.reservoir
+            .iter()
+            .any(|l| l.verdict(tol) == Verdict::Fail && l.simulated > Some(l.measured)),
+        "gravity x 0.8 must keep the reservoir too high:\n{}",
+        weak.table()
+    );
+
+    let (_, open) = dam_break(1.0, |s| s.obstacle = false);
+    let lee = open.arrivals.iter().find(|a| a.gauge == LEE_GAUGE).unwrap();
+    assert_eq!(
+        lee.verdict(open.tolerances.arrival_window(LEE_GAUGE)),
+        Verdict::Fail,
+        "without the box H1 must be reached early:\n{}",
+        open.table()
+    );
+    assert!(lee.delay().is_some_and(|d| d < 0.0), "{}", open.table());
+}
+
+/// `scenes/kleefsman_obstacle.json` is the default setup's scene, and it builds.
+#[test]
+fn shipped_scene_is_the_default_setup() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/kleefsman_obstacle.json");
+    let loaded = Scene::load(&path).unwrap();
+    let expected = Setup::default().scene();
+    assert_eq!(loaded, expected, "expected:\n{}", expected.to_json());
+    assert_eq!(loaded.particle_count(), 49 * 22 * 40);
+}
+
+fn projfluid(args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_projfluid"))
+        .args(args)
+        .output()
+        .expect("run projfluid")
+}
+
+fn scratch(name: &str) -> PathBuf {
+    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join("kleefsman")
+        .join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+#[test]
+fn cli_kleefsman_writes_its_table_csv_and_charts() {
+    let dir = scratch("cli");
+    let out = projfluid(&[
+        "validate",
+        "kleefsman",
+        "--radius",
+        "0.05",
+        "--duration",
+        "0.5",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for key in [
+        "surge arrival",
+        "reservoir height at H4",
+        "RMS",
+        "not reached",
+    ] {
+        assert!(stdout.contains(key), "`{key}` missing:\n{stdout}");
+    }
+    for g in ["H1", "H2", "H3", "H4"] {
+        let png = std::fs::read(dir.join(format!("kleefsman_{g}.png"))).unwrap();
+        assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    }
+    let series = std::fs::read_to_string(dir.join("kleefsman_series.csv")).unwrap();
+    assert!(series.starts_with("t_s,H1_m,H2_m,H3_m,H4_m\n"), "{series}");
+    let csv = std::fs::read_to_string(dir.join("kleefsman_comparison.csv")).unwrap();
+    assert!(csv.lines().any(|l| l.starts_with("arrival_s,H1,")), "{csv}");
+}
+
+#[test]
+fn cli_kleefsman_rejects_bad_options_with_exit_code_2() {
+    let dir = scratch("bad");
+    let out_dir = dir.to_str().unwrap();
+    for (option, value) in [
+        ("--radius", "0.001"),
+        ("--radius", "nan"),
+        ("--duration", "0"),
+        ("--gravity", "-9.81"),
+        ("--viscosity", "1.5"),
+        ("--tau", "-1"),
+    ] {
+        let out = projfluid(&["validate", "kleefsman", option, value, "--out", out_dir]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{option} {value}: {stderr}");
+        assert!(stderr.contains(option), "{option} {value}: {stderr}");
+    }
+    assert!(
+        !dir.exists(),
+        "a rejected command must not create its output directory"
+    );
+}

@@ -78,6 +78,54 @@ fn line_chart_writes_a_png_of_the_chart_size() {
     assert!(colours >= 5, "only {colours} colours");
 }
 
+/// The RGB pixels of the PNG at `path`, row by row.
+fn pixels(path: &Path) -> Vec<[u8; 3]> {
+    let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    buf[..info.buffer_size()]
+        .chunks(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect()
+}
+
+/// A series that drops and jumps within a few samples (a gauge as the first water arrives)
+/// stays inside the plotting area: nothing of the series' colour (blue: the first series)
+/// below the x axis, where only the tick labels and the axis title are drawn.
+#[test]
+fn a_jagged_line_stays_inside_the_chart() {
+    let dir = scratch("jagged");
+    let drop_and_jump = [
+        0.0082, 0.0073, 0.0066, 0.0061, 0.0061, 0.0070, 0.0092, 0.0135, 0.0202, 0.0260, 0.0290,
+        0.0292, 0.0200, 0.0101, 0.0060, 0.0047, 0.0047, 0.0058, 0.0096, 0.0852, 0.0833, 0.0733,
+        0.0684, 0.0668, 0.0656, 0.0642, 0.0620, 0.0595, 0.0572, 0.0559,
+    ];
+    let mut points: Vec<(f64, f64)> = (0..600).map(|i| (i as f64 * 0.002, 0.0016)).collect();
+    points.extend(
+        drop_and_jump
+            .iter()
+            .enumerate()
+            .map(|(i, &h)| (1.2 + i as f64 * 0.0016, h)),
+    );
+    points.extend((0..400).map(|i| (1.25 + i as f64 * 0.002, 0.3)));
+    let chart = LineChart {
+        title: "Water height".into(),
+        x_label: "t (s)".into(),
+        y_label: "height (m)".into(),
+        series: vec![series("simulation", points, SeriesStyle::Line)],
+    };
+    let path = dir.join("jagged.png");
+    chart.write_png(&path).unwrap();
+    let image = pixels(&path);
+    let blue = |p: &[u8; 3]| p[2] as i32 > p[0] as i32 + 60;
+    assert!(image.iter().any(blue), "the series is drawn in blue");
+    // The x axis's tick labels and title take the bottom 57 rows (margin and label area).
+    let below_axis = &image[(WIDTH * (HEIGHT - 50)) as usize..];
+    let stray = below_axis.iter().filter(|p| blue(p)).count();
+    assert_eq!(stray, 0, "{stray} blue pixels below the x axis");
+}
+
 #[test]
 fn a_single_point_still_makes_a_chart() {
     let dir = scratch("single");

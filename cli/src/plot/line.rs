@@ -71,8 +71,12 @@ impl LineChart {
             let line = matches!(s.style, SeriesStyle::Line | SeriesStyle::LineMarkers);
             let markers = matches!(s.style, SeriesStyle::Markers | SeriesStyle::LineMarkers);
             if line {
+                // Segment by segment: plotters joins a wide polyline's segments with mitres,
+                // which at a sharp reversal (a gauge reading that drops and jumps within a few
+                // samples) shoot far outside the chart.
+                let segments = s.points.windows(2);
                 chart
-                    .draw_series(LineSeries::new(s.points.iter().copied(), c.stroke_width(2)))
+                    .draw_series(segments.map(|w| PathElement::new(w.to_vec(), c.stroke_width(2))))
                     .map_err(|e| e.to_string())?;
             }
             if markers {

@@ -2,12 +2,14 @@
 //! at a coarse resolution, its discrimination (a broken gravity or a missing box must fail it),
 //! the shipped scene, and `projfluid validate kleefsman`.
 
+mod support;
+
 use projfluid::scene::Scene;
 use projfluid_lab::validation::kleefsman::{
     self, Comparison, LEE_GAUGE, Measurements, Run, Setup, Tolerances, Verdict,
 };
 use std::path::{Path, PathBuf};
-use std::process::Command;
+use support::projfluid;
 
 /// Particle radius of the tests (m): d = 5 cm, 11 particles over the depth, 5,500 in all (the
 /// command's default is 12.5 mm).
@@ -99,19 +101,9 @@ fn shipped_scene_is_the_default_setup() {
     assert_eq!(loaded.particle_count(), 49 * 22 * 40);
 }
 
-fn projfluid(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_projfluid"))
-        .args(args)
-        .output()
-        .expect("run projfluid")
-}
-
+/// `name` under this file's directory for test files, emptied.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("kleefsman")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    support::scratch("kleefsman", name)
 }
 
 #[test]

@@ -1,13 +1,15 @@
 //! Validation against experiment: the Martin & Moyce (1952) column collapse at a coarse
 //! resolution, a tank at rest, and the `projfluid validate` command line.
 
+mod support;
+
 use projfluid::SolverKind;
 use projfluid_lab::validation::hydrostatic;
 use projfluid_lab::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
 use projfluid_lab::validation::reference::Measurements;
 use std::path::PathBuf;
-use std::process::Command;
 use std::sync::OnceLock;
+use support::projfluid;
 
 /// Particles across the column width a in the tests (the CLI default is 20).
 const TEST_RESOLUTION: usize = 16;
@@ -190,19 +192,9 @@ fn tank_at_rest_comes_to_rest() {
     );
 }
 
-fn projfluid(args: &[&str]) -> std::process::Output {
-    Command::new(env!("CARGO_BIN_EXE_projfluid"))
-        .args(args)
-        .output()
-        .expect("run projfluid")
-}
-
+/// `name` under this file's directory for test files, emptied.
 fn scratch(name: &str) -> PathBuf {
-    let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join("validation")
-        .join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
+    support::scratch("validation", name)
 }
 
 #[test]

@@ -226,7 +226,7 @@ typedef struct PfParams {
     enum PfOmega2Rule omega2_rule;
     /**
      * Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.95.
+     * `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.99.
      */
     double chebyshev_rho;
     /**

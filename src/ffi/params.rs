@@ -76,7 +76,7 @@ pub struct PfParams {
     /// Rule for the first Chebyshev weight. Default `PF_OMEGA2_PAPER`.
     pub omega2_rule: PfOmega2Rule,
     /// Estimated spectral radius ρ_c for Chebyshev acceleration, in [0, 1); with
-    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.95.
+    /// `chebyshev_auto_rho` = 1 only the value used until the first estimate. Default 0.99.
     pub chebyshev_rho: f64,
     /// Outer iterations (≥ 1) before Chebyshev extrapolation starts. Default 1.
     pub chebyshev_delay: u32,

@@ -1,5 +1,5 @@
-//! Neighbour lists in compressed (CSR) form, kept in the blocks the search wrote them in;
-//! points by component; and the parallel walk over CSR segments.
+//! Neighbour lists in compressed (CSR) form, kept per block of queries; points by
+//! component; and the parallel walk over CSR segments.
 
 use super::BLOCK;
 use crate::Vec3;
@@ -7,9 +7,9 @@ use crate::reserve::reserve_total;
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
-/// Neighbour lists in compressed form, kept where the search wrote them: the queries are
-/// taken in blocks of 256, and block b's lists are concatenated in `blocks[b]`, each list
-/// ascending.
+/// Neighbour lists in compressed form, kept per block: the queries are taken in blocks of
+/// 256, and block b's lists are concatenated in `blocks[b]`, each list ascending, in
+/// storage of about their size.
 #[derive(Clone, Debug, Default)]
 pub struct NeighborLists {
     /// The number of queries.
@@ -80,23 +80,16 @@ impl NeighborLists {
         self.blocks = Vec::new();
     }
 
-    /// Reserves room for a search of `queries` points finding about `per_query` neighbours
-    /// each (more where a block found more last time), so that such a search allocates
-    /// nothing unless some queries find more. The lists found so far stay as they are.
-    pub(crate) fn try_reserve(
-        &mut self,
-        queries: usize,
-        per_query: usize,
-    ) -> Result<(), TryReserveError> {
+    /// Reserves room for the blocks of a search of `queries` points and their starts. The
+    /// lists themselves are sized by the search, to what it finds.
+    pub(crate) fn try_reserve(&mut self, queries: usize) -> Result<(), TryReserveError> {
         let blocks = queries.div_ceil(BLOCK);
         reserve_total(&mut self.blocks, blocks)?;
         while self.blocks.len() < blocks {
             self.blocks.push(Default::default());
         }
-        for (starts, found) in &mut self.blocks[..blocks] {
+        for (starts, _) in &mut self.blocks[..blocks] {
             reserve_total(starts, BLOCK + 1)?;
-            let more = found.len() + found.len() / 4;
-            reserve_total(found, more.max(BLOCK.saturating_mul(per_query)))?;
         }
         self.coordinates.try_reserve(queries)
     }

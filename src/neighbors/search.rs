@@ -86,7 +86,9 @@ impl UniformGrid {
         reserve_total(&mut out.blocks, blocks)?;
         out.blocks.resize_with(blocks, Default::default);
         // Each block grows only its own lists, so what they hold does not depend on the
-        // thread count; a block that runs out of memory fails the whole search.
+        // thread count; a block that runs out of memory fails the whole search. A block is
+        // searched into its thread's buffer, which has room for every candidate of a query,
+        // and only the neighbours found are kept in the block's lists.
         out.blocks
             .par_iter_mut()
             .enumerate()
@@ -100,7 +102,15 @@ impl UniformGrid {
                     r2,
                     exclude_self: first_self.map(|own| own + first),
                 };
-                block.search(queries, starts, found)
+                let mut searched = FOUND.take();
+                let kept = block
+                    .search(queries, starts, &mut searched)
+                    .and_then(|()| keep(&searched, found));
+                if searched.capacity() > FOUND_KEPT {
+                    searched = Vec::new();
+                }
+                FOUND.set(searched);
+                kept
             })?;
         out.queries = queries.len();
         Ok(())
@@ -265,6 +275,27 @@ impl Block<'_> {
     }
 }
 
+/// Makes `lists` a copy of a block's `found` lists, in storage of about their size: grown
+/// when it is short, with [`LIST_HEADROOM`] to spare, and replaced when it is more than
+/// twice that (and than two lists per query), so that the lists hold little more than what
+/// the last search found.
+/// Errors, leaving `lists` empty, when memory for them cannot be had.
+fn keep(found: &[u32], lists: &mut Vec<u32>) -> Result<(), TryReserveError> {
+    lists.clear();
+    let room = found.len() + found.len() / LIST_HEADROOM;
+    if lists.capacity() < found.len() || lists.capacity() > 2 * room.max(BLOCK) {
+        let mut exact = Vec::new();
+        exact.try_reserve_exact(room)?;
+        *lists = exact;
+    }
+    lists.extend_from_slice(found);
+    Ok(())
+}
+
+/// A block's lists are stored with room for 1/`LIST_HEADROOM` more neighbours than found,
+/// so that a block whose particles gain a few neighbours keeps its storage.
+const LIST_HEADROOM: usize = 16;
+
 /// Makes room in `found` for `additional` more neighbours: out of the search's loop, which
 /// only compares the room left with what a query may need.
 #[cold]
@@ -320,7 +351,14 @@ pub(super) fn push_within_portable(
 thread_local! {
     /// The candidate points of a block's current cell and their indices, per thread.
     static CANDIDATES: std::cell::Cell<(PointsByComponent, Vec<u32>)> = Default::default();
+    /// The neighbours a block found, before [`keep`] copies them into its lists, per
+    /// thread.
+    static FOUND: std::cell::Cell<Vec<u32>> = Default::default();
 }
+
+/// The most neighbours (and room for candidates) a thread's [`FOUND`] buffer keeps between
+/// blocks: more, grown for a block of crowded particles, is given back after it.
+const FOUND_KEPT: usize = 1 << 16;
 
 #[cfg(test)]
 mod tests {

@@ -17,17 +17,15 @@ use std::collections::TryReserveError;
 impl StepBuffers {
     /// Reserves what steps of `fluid` fluid particles need, so that they allocate nothing
     /// where sizes are known (docs/method.md §1.3): every per-particle buffer, the scratch of
-    /// the sort, the fluid neighbour lists for about `per_query` neighbours per particle (or
-    /// what each block held last time, with a quarter more), the boundary lists' blocks, δ_k
-    /// for `iterations` outer iterations, the loads on `bodies` bodies and the walls, and room
-    /// to keep the state of `bodies` bodies and `emitters` emitters for an undo. What cannot
-    /// be known before a step — more neighbours than that, the segments of kept corrections,
-    /// a rebuilt grid, the slots of the body coupling — grows during it through fallible
-    /// reservations, and a step that cannot have it is undone.
+    /// the sort, the blocks of the neighbour lists, δ_k for `iterations` outer iterations,
+    /// the loads on `bodies` bodies and the walls, and room to keep the state of `bodies`
+    /// bodies and `emitters` emitters for an undo. What cannot be known before a step — the
+    /// neighbour lists themselves, the segments of kept corrections, a rebuilt grid, the
+    /// slots of the body coupling — grows during it through fallible reservations, and a
+    /// step that cannot have it is undone.
     pub(crate) fn try_reserve(
         &mut self,
         fluid: usize,
-        per_query: usize,
         iterations: usize,
         bodies: usize,
         emitters: usize,
@@ -49,8 +47,8 @@ impl StepBuffers {
         reserve_total(&mut self.displacements, iterations)?;
         self.table.try_reserve(fluid, 0)?;
         self.corrections.try_reserve(fluid)?;
-        self.fluid_lists.try_reserve(fluid, per_query)?;
-        self.boundary_lists.try_reserve(fluid, 0)?;
+        self.fluid_lists.try_reserve(fluid)?;
+        self.boundary_lists.try_reserve(fluid)?;
         if bodies > 0 {
             reserve_total(&mut self.loads, bodies + 1)?;
         }

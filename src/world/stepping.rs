@@ -15,10 +15,6 @@ use crate::params::check_step;
 use crate::stats::StepStats;
 use crate::step::{StepContext, idle_step, take_step};
 
-/// Neighbours per fluid particle reserved for, as a multiple of the stencil size at rest
-/// density (compressed fluid holds a few per cent more).
-const NEIGHBOR_SLACK: f64 = 1.25;
-
 /// The relative precision to which a duration is kept: steps end within this fraction of
 /// the end time (s) of it, so that rounding never leaves a vanishing last step.
 const CLOCK_RESOLUTION: f64 = 1e-12;
@@ -94,11 +90,10 @@ impl World {
         let oom = |_| Error::out_of_memory("the storage of the time steps");
         self.try_reserve_fluid(most - self.fluid_count())
             .map_err(oom)?;
-        let per_query = (self.params.rest_stencil_size() * NEIGHBOR_SLACK).ceil() as usize;
         let iterations = self.params.max_outer_iterations;
         let (bodies, emitters) = (self.bodies.len(), self.emitters.len());
         self.buffers
-            .try_reserve(most, per_query, iterations, bodies, emitters)
+            .try_reserve(most, iterations, bodies, emitters)
             .map_err(oom)?;
         self.solver.try_reserve(most).map_err(oom)?;
         for force in &mut self.forces {

@@ -11,10 +11,12 @@ pub mod mesh;
 mod particles;
 pub mod shapes;
 pub mod transform;
+mod undo;
 pub mod winding;
 
-pub(crate) use particles::{Boundary, BoundaryCopy};
+pub(crate) use particles::Boundary;
 pub use transform::Transform;
+pub(crate) use undo::BoundaryCopy;
 
 /// The owner index of boundary particles that belong to walls and static obstacles rather
 /// than to a body.
@@ -32,15 +34,21 @@ pub struct Aabb {
 impl Aabb {
     /// The smallest box holding every point, or `None` for no points.
     pub fn around(points: &[Vec3]) -> Option<Self> {
-        let first = *points.first()?;
-        Some(points.iter().fold(
+        Self::enclosing(points.iter().copied())
+    }
+
+    /// [`Aabb::around`] the points (m) an iterator yields.
+    pub fn enclosing(points: impl IntoIterator<Item = Vec3>) -> Option<Self> {
+        let mut points = points.into_iter();
+        let first = points.next()?;
+        Some(points.fold(
             Aabb {
                 min: first,
                 max: first,
             },
             |b, p| Aabb {
-                min: b.min.inf(p),
-                max: b.max.sup(p),
+                min: b.min.inf(&p),
+                max: b.max.sup(&p),
             },
         ))
     }
@@ -101,18 +109,17 @@ pub(crate) fn sample_box_walls_into(
 }
 
 /// Akinci volumes V_b = 1/Σ_{b'} W(x_b − x_b') (self included) for boundary particles
-/// `points` sorted by `table` on `grid` (`by_component`: the same points by component), in
-/// m³. The neighbours are searched [`VOLUME_BATCH`] particles at a time, so that only one
-/// batch's lists are held (a whole boundary's were once the largest allocation of a world).
-/// Errors when memory for the volumes or a batch's lists cannot be had.
+/// `points` (m) sorted by `table` on `grid`, in m³. The neighbours are searched
+/// [`VOLUME_BATCH`] particles at a time, so that only one batch's lists are held (a whole
+/// boundary's were once the largest allocation of a world). Errors when memory for the
+/// volumes or a batch's lists cannot be had.
 pub fn akinci_volumes(
     grid: &UniformGrid,
     table: &CellTable,
-    points: &[Vec3],
-    by_component: &PointsByComponent,
+    points: &PointsByComponent,
     kernel: &CubicKernel,
 ) -> Result<Vec<f64>, TryReserveError> {
-    volumes_in_batches(grid, table, points, by_component, kernel, VOLUME_BATCH)
+    volumes_in_batches(grid, table, points, kernel, VOLUME_BATCH)
 }
 
 /// How many boundary particles [`akinci_volumes`] searches at a time.
@@ -122,23 +129,25 @@ const VOLUME_BATCH: usize = 1 << 14;
 fn volumes_in_batches(
     grid: &UniformGrid,
     table: &CellTable,
-    points: &[Vec3],
-    by_component: &PointsByComponent,
+    points: &PointsByComponent,
     kernel: &CubicKernel,
     batch: usize,
 ) -> Result<Vec<f64>, TryReserveError> {
-    let mut lists = NeighborLists::default();
+    let (mut lists, mut queries) = (NeighborLists::default(), Vec::new());
     let mut volumes = Vec::new();
     volumes.try_reserve_exact(points.len())?;
+    queries.try_reserve_exact(batch.min(points.len()))?;
     let h = kernel.support_radius();
     for first in (0..points.len()).step_by(batch) {
-        let queries = &points[first..first.saturating_add(batch).min(points.len())];
-        grid.search_from(table, by_component, queries, Some(first), h, &mut lists)?;
+        queries.clear();
+        queries
+            .extend((first..first.saturating_add(batch).min(points.len())).map(|i| points.at(i)));
+        grid.search_from(table, points, &queries, Some(first), h, &mut lists)?;
         volumes.par_extend(queries.par_iter().enumerate().map(|(k, x)| {
             let sum: f64 = lists
                 .of(k)
                 .iter()
-                .map(|&c| kernel.w((x - points[c as usize]).norm()))
+                .map(|&c| kernel.w((x - points.at(c as usize)).norm()))
                 .sum();
             1.0 / (kernel.w_zero() + sum)
         }));
@@ -163,7 +172,7 @@ pub(crate) fn own_masses(
     let sorted: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
     let mut by_component = PointsByComponent::default();
     by_component.fill(&sorted)?;
-    let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, kernel)?;
+    let volumes = akinci_volumes(&grid, &table, &by_component, kernel)?;
     let mut psi = vec![0.0; points.len()];
     for (&i, v) in order.iter().zip(volumes) {
         psi[i as usize] = v * rest_density;
@@ -222,7 +231,7 @@ mod tests {
         let sorted: Vec<Vec3> = order.iter().map(|&i| pts[i as usize]).collect();
         let mut by_component = PointsByComponent::default();
         by_component.fill(&sorted).unwrap();
-        let volumes = akinci_volumes(&grid, &table, &sorted, &by_component, &kernel).unwrap();
+        let volumes = akinci_volumes(&grid, &table, &by_component, &kernel).unwrap();
         let centre = sorted
             .iter()
             .position(|p| (p - Vec3::new(0.5, 0.0, 0.5)).norm() < 1e-9)
@@ -237,12 +246,10 @@ mod tests {
         assert!(volumes[corner] > 2.0 * volumes[centre]);
         // Searched in batches of any size (one point, a few, or more than a cell's), every
         // volume comes out bit for bit as from one search of all points.
-        let whole =
-            volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, usize::MAX).unwrap();
+        let whole = volumes_in_batches(&grid, &table, &by_component, &kernel, usize::MAX).unwrap();
         assert_eq!(volumes, whole);
         for batch in [1, 7, 100, 1000] {
-            let parts =
-                volumes_in_batches(&grid, &table, &sorted, &by_component, &kernel, batch).unwrap();
+            let parts = volumes_in_batches(&grid, &table, &by_component, &kernel, batch).unwrap();
             assert_eq!(parts, whole, "batches of {batch}");
         }
     }

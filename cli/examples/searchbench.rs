@@ -20,7 +20,7 @@ fn main() {
         .world;
     let repetitions: usize = a[1].parse().expect("repetitions");
     let fluid = world.positions();
-    let boundary = world.boundary_positions();
+    let boundary = &world.boundary_positions()[..];
     let h = world.params().support_radius();
     let bounds = [&fluid[..], boundary]
         .into_iter()

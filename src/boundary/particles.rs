@@ -7,6 +7,7 @@
 //! the masses computed in their own frames, and sorted in among the static ones.
 
 use super::WALLS;
+use super::undo::{BoundaryCopy, permute_in_place};
 use crate::Vec3;
 use crate::boundary::akinci_volumes;
 use crate::kernel::CubicKernel;
@@ -17,16 +18,15 @@ use std::collections::TryReserveError;
 /// Boundary particles, sorted by the grid's cells, with their Akinci masses and owners.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct Boundary {
-    /// Positions (m), in the grid's cell order once sorted.
-    pub positions: Vec<Vec3>,
+    /// Positions (m), in the grid's cell order once sorted; by component, as the neighbour
+    /// search reads them.
+    pub positions: PointsByComponent,
     /// ψ_b = ρ0·V_b (kg), valid unless `dirty`.
     pub psi: Vec<f64>,
     /// The body each particle belongs to, or [`WALLS`].
     pub owner: Vec<u32>,
     /// Where each grid cell's particles lie in `positions`.
     pub table: CellTable,
-    /// `positions` by component, for the neighbour search (valid unless `dirty`).
-    pub by_component: PointsByComponent,
     /// Set when particles were added or the grid changed: sort and volumes must be redone.
     pub dirty: bool,
     /// Whether the body of each owner index moves (its particles are placed every step).
@@ -39,47 +39,9 @@ pub(crate) struct Boundary {
 #[derive(Clone, Debug, Default)]
 struct Spare {
     order: Vec<u32>,
-    positions: Vec<Vec3>,
+    positions: PointsByComponent,
     psi: Vec<f64>,
     owner: Vec<u32>,
-}
-
-/// A copy of the arrays of a [`Boundary`] that a step changes (sorting it anew, placing the
-/// moving bodies' particles), taken before it changes them so that a step that fails can
-/// put them back ([`Boundary::restore`]). Its storage is kept from step to step.
-#[derive(Clone, Debug, Default)]
-pub(crate) struct BoundaryCopy {
-    positions: Vec<Vec3>,
-    psi: Vec<f64>,
-    owner: Vec<u32>,
-    table: CellTable,
-    by_component: PointsByComponent,
-    dirty: bool,
-    /// The arrays hold a copy not yet put back or discarded.
-    held: bool,
-}
-
-impl BoundaryCopy {
-    /// Forgets the copy held (after the step that took it succeeded), keeping the storage.
-    pub fn discard(&mut self) {
-        self.held = false;
-    }
-}
-
-/// Makes `out` a copy of `from`, reusing its storage.
-fn copy_into<T: Copy>(out: &mut Vec<T>, from: &[T]) -> Result<(), TryReserveError> {
-    out.clear();
-    reserve_total(out, from.len())?;
-    out.extend_from_slice(from);
-    Ok(())
-}
-
-/// `data` reordered so that slot k holds `data[order[k]]`, in new storage.
-fn permuted<T: Copy>(order: &[u32], data: &[T]) -> Result<Vec<T>, TryReserveError> {
-    let mut out = Vec::new();
-    out.try_reserve_exact(order.len())?;
-    out.extend(order.iter().map(|&i| data[i as usize]));
-    Ok(out)
 }
 
 /// Reorders `data` so that slot k holds the old `data[order[k]]`, through `spare`, which
@@ -96,6 +58,11 @@ impl Boundary {
         self.positions.extend_from_slice(positions);
         self.owner.resize(self.positions.len(), owner);
         self.dirty = true;
+    }
+
+    /// The number of particles.
+    pub fn len(&self) -> usize {
+        self.positions.len()
     }
 
     /// Records whether body `owner`'s particles move.
@@ -125,7 +92,7 @@ impl Boundary {
             if self.is_moving(self.owner[k]) {
                 continue;
             }
-            self.positions[kept] = self.positions[k];
+            self.positions.set(kept, self.positions.at(k));
             self.owner[kept] = self.owner[k];
             if with_psi {
                 self.psi[kept] = self.psi[k];
@@ -140,27 +107,38 @@ impl Boundary {
     }
 
     /// Sorts the static particles into `grid`'s cells and computes their Akinci masses with
-    /// `kernel` and the rest density ρ0 (kg/m³); runs on the caller's thread pool. Errors
-    /// when memory for the sort or the volumes cannot be had: the boundary is then left
-    /// marked for sorting (`dirty`), its moving bodies' particles dropped, and a caller that
-    /// must change nothing keeps a copy ([`Boundary::save`]).
+    /// `kernel` and the rest density ρ0 (kg/m³); runs on the caller's thread pool. What the
+    /// sort changes is kept in `copy` first, unless it holds the boundary from before a
+    /// change already: the whole boundary where bodies move (their particles are dropped),
+    /// else only the order the particles are sorted into (they are reordered in place), with
+    /// the masses and the cell table that the sort replaces. Errors when memory for the sort,
+    /// the volumes or the copy cannot be had, with what it changed kept in `copy`
+    /// ([`Boundary::restore`] puts it back).
     pub fn sort(
         &mut self,
         grid: &UniformGrid,
         kernel: &CubicKernel,
         rest_density: f64,
+        copy: &mut BoundaryCopy,
     ) -> Result<(), TryReserveError> {
+        if self.has_moving() {
+            self.save(copy)?;
+            self.dirty = true;
+            self.drop_moving();
+        }
+        let (mut order, mut table) = (Vec::new(), CellTable::default());
+        grid.sort_by_component(&self.positions, &mut order, &mut table)?;
+        table.release_scratch();
+        let (positions, owner) = (&mut self.positions, &mut self.owner);
+        permute_in_place(&mut order, |a, b| {
+            positions.swap(a, b);
+            owner.swap(a, b);
+        });
+        let table = std::mem::replace(&mut self.table, table);
+        let psi = std::mem::take(&mut self.psi);
+        copy.sorted(order, psi, table, self.dirty);
         self.dirty = true;
-        self.drop_moving();
-        let mut order = Vec::new();
-        grid.sort(&self.positions, &mut order, &mut self.table)?;
-        self.table.release_scratch();
-        let positions = permuted(&order, &self.positions)?;
-        let owner = permuted(&order, &self.owner)?;
-        self.by_component.fill(&positions)?;
-        let volumes = akinci_volumes(grid, &self.table, &positions, &self.by_component, kernel)?;
-        self.positions = positions;
-        self.owner = owner;
+        let volumes = akinci_volumes(grid, &self.table, &self.positions, kernel)?;
         // The volumes' storage becomes the masses'.
         self.psi = volumes;
         self.psi.iter_mut().for_each(|v| *v *= rest_density);
@@ -180,7 +158,7 @@ impl Boundary {
     ) -> Result<(), TryReserveError> {
         self.drop_moving();
         for (x, psi, owner) in moving {
-            self.positions.try_reserve(1)?;
+            self.positions.try_reserve(self.positions.len() + 1)?;
             self.psi.try_reserve(1)?;
             self.owner.try_reserve(1)?;
             self.positions.push(x);
@@ -190,58 +168,35 @@ impl Boundary {
         // The sort's order and the permuted copies live in reusable buffers: this runs every
         // step while bodies move.
         let (n, spare) = (self.positions.len(), &mut self.spare);
-        grid.sort(&self.positions, &mut spare.order, &mut self.table)?;
-        reserve_total(&mut spare.positions, n)?;
+        grid.sort_by_component(&self.positions, &mut spare.order, &mut self.table)?;
         reserve_total(&mut spare.psi, n)?;
         reserve_total(&mut spare.owner, n)?;
-        self.by_component.try_reserve(n)?;
-        permute(&spare.order, &mut self.positions, &mut spare.positions);
+        spare
+            .positions
+            .try_permuted_from(&self.positions, &spare.order)?;
+        std::mem::swap(&mut self.positions, &mut spare.positions);
         permute(&spare.order, &mut self.psi, &mut spare.psi);
         permute(&spare.order, &mut self.owner, &mut spare.owner);
-        self.by_component.fill(&self.positions)
-    }
-
-    /// Copies into `copy` the arrays that sorting or placing changes, unless it holds a copy
-    /// already (the boundary as it was before the first change of a step); errors when
-    /// memory for the copy cannot be had, changing nothing but `copy`'s storage.
-    pub fn save(&self, copy: &mut BoundaryCopy) -> Result<(), TryReserveError> {
-        if copy.held {
-            return Ok(());
-        }
-        copy_into(&mut copy.positions, &self.positions)?;
-        copy_into(&mut copy.psi, &self.psi)?;
-        copy_into(&mut copy.owner, &self.owner)?;
-        copy.table.try_copy_from(&self.table)?;
-        copy.by_component.try_copy_from(&self.by_component)?;
-        copy.dirty = self.dirty;
-        copy.held = true;
         Ok(())
     }
 
-    /// Puts back the arrays `copy` holds, if it holds any (swapped, not copied: this cannot
-    /// fail), and leaves `copy` holding none.
-    pub fn restore(&mut self, copy: &mut BoundaryCopy) {
-        if !std::mem::take(&mut copy.held) {
-            return;
-        }
-        std::mem::swap(&mut self.positions, &mut copy.positions);
-        std::mem::swap(&mut self.psi, &mut copy.psi);
-        std::mem::swap(&mut self.owner, &mut copy.owner);
-        std::mem::swap(&mut self.table, &mut copy.table);
-        std::mem::swap(&mut self.by_component, &mut copy.by_component);
-        self.dirty = copy.dirty;
-    }
-
     /// A boundary of static particles at `positions` (m) that belong to `owner`s, unsorted,
-    /// with this one's record of which bodies move.
-    pub fn with_statics(&self, positions: Vec<Vec3>, owner: Vec<u32>) -> Self {
-        Boundary {
-            positions,
+    /// with this one's record of which bodies move; or an error when memory for it cannot
+    /// be had.
+    pub fn with_statics(
+        &self,
+        positions: &[Vec3],
+        owner: Vec<u32>,
+    ) -> Result<Self, TryReserveError> {
+        let mut boundary = Boundary {
             owner,
             dirty: true,
             moving: self.moving.clone(),
             ..Default::default()
-        }
+        };
+        boundary.positions.try_reserve(positions.len())?;
+        boundary.positions.extend_from_slice(positions);
+        Ok(boundary)
     }
 
     /// The static particles' positions (m) and owners, in their sorted order.
@@ -250,7 +205,7 @@ impl Boundary {
             .iter()
             .zip(&self.owner)
             .filter(|(_, o)| !self.is_moving(**o))
-            .map(|(x, o)| (*x, *o))
+            .map(|(x, o)| (x, *o))
             .unzip()
     }
 }

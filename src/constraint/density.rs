@@ -29,7 +29,7 @@ impl DensityConstraint {
             .iter()
             .map(|&b| {
                 let b = b as usize;
-                nb.boundary_psi[b] * k.w((xi - nb.boundary_positions[b]).norm())
+                nb.boundary_psi[b] * k.w((xi - nb.boundary_positions.at(b)).norm())
             })
             .sum();
         self.mass * (k.w_zero() + fluid) + boundary
@@ -90,7 +90,7 @@ impl DensityConstraint {
             .zip(&mut bm.rz)
             .zip(&mut bm.psi)
         {
-            let xb = &nb.boundary_positions[b as usize];
+            let xb = nb.boundary_positions.at(b as usize);
             (*rx, *ry, *rz) = (xi.x - xb.x, xi.y - xb.y, xi.z - xb.z);
             *psi = nb.boundary_psi[b as usize];
         }

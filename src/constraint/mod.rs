@@ -15,9 +15,8 @@ mod stencil;
 pub use gather::Corrections;
 pub use projection::Projection;
 
-use crate::Vec3;
 use crate::kernel::CubicKernel;
-use crate::neighbors::NeighborLists;
+use crate::neighbors::{NeighborLists, PointsByComponent};
 use crate::params::ProjectionWeight;
 use std::collections::TryReserveError;
 
@@ -72,7 +71,7 @@ pub struct Neighborhood<'a> {
     /// Boundary neighbours of each fluid particle.
     pub boundary: &'a NeighborLists,
     /// Boundary particle positions (m).
-    pub boundary_positions: &'a [Vec3],
+    pub boundary_positions: &'a PointsByComponent,
     /// Boundary particle masses ψ_b (kg).
     pub boundary_psi: &'a [f64],
     /// The weight w_j of every fluid particle in a projection
@@ -114,6 +113,7 @@ pub struct DensityConstraint {
 #[cfg(test)]
 mod test_cluster {
     use super::*;
+    use crate::Vec3;
     use crate::neighbors::{CellTable, UniformGrid};
 
     /// Fluid positions (m) with their neighbour lists among the fluid and the boundary, the
@@ -123,6 +123,8 @@ mod test_cluster {
         pub(super) fl: NeighborLists,
         pub(super) bl: NeighborLists,
         pub(super) bx: Vec<Vec3>,
+        /// `bx` by component, as the constraints read it.
+        pub(super) bx_components: PointsByComponent,
         pub(super) psi: Vec<f64>,
         pub(super) weights: Vec<f64>,
     }
@@ -133,7 +135,7 @@ mod test_cluster {
             Neighborhood {
                 fluid: &self.fl,
                 boundary: &self.bl,
-                boundary_positions: &self.bx,
+                boundary_positions: &self.bx_components,
                 boundary_psi: &self.psi,
                 weights: &self.weights,
             }
@@ -173,11 +175,14 @@ mod test_cluster {
             .unwrap();
         let mut weights = Vec::new();
         constraint.weights(&fl, &mut weights);
+        let mut bx_components = PointsByComponent::default();
+        bx_components.fill(&bx).unwrap();
         Cluster {
             x,
             fl,
             bl,
             bx,
+            bx_components,
             psi,
             weights,
         }

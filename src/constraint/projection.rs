@@ -152,7 +152,7 @@ impl DensityConstraint {
             .iter()
             .map(|&b| {
                 let b = b as usize;
-                kernel.grad_w(&(pi - nb.boundary_positions[b])) * nb.boundary_psi[b]
+                kernel.grad_w(&(pi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
             })
             .sum::<Vec3>()
             / self.rest_density;

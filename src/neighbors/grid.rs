@@ -1,6 +1,7 @@
 //! The uniform grid: cells of edge H ranked in Z-order (Morton order), and the counting sort
 //! of points by cell into a [`CellTable`] (docs/method.md §6).
 
+use super::PointsByComponent;
 use crate::Vec3;
 use crate::reserve::reserve_total;
 use rayon::prelude::*;
@@ -141,17 +142,39 @@ impl UniformGrid {
         order: &mut Vec<u32>,
         table: &mut CellTable,
     ) -> Result<bool, TryReserveError> {
-        table.try_reserve(points.len(), self.cell_count())?;
-        reserve_total(order, points.len())?;
+        self.sort_with(points.len(), |i| points[i], order, table)
+    }
+
+    /// [`UniformGrid::sort`] of points held by component.
+    pub fn sort_by_component(
+        &self,
+        points: &PointsByComponent,
+        order: &mut Vec<u32>,
+        table: &mut CellTable,
+    ) -> Result<bool, TryReserveError> {
+        self.sort_with(points.len(), |i| points.at(i), order, table)
+    }
+
+    /// [`UniformGrid::sort`] of the `count` points `at(0)`, `at(1)`, … (m).
+    fn sort_with(
+        &self,
+        count: usize,
+        at: impl Fn(usize) -> Vec3 + Sync,
+        order: &mut Vec<u32>,
+        table: &mut CellTable,
+    ) -> Result<bool, TryReserveError> {
+        table.try_reserve(count, self.cell_count())?;
+        reserve_total(order, count)?;
         let ranks = &mut table.ranks;
-        ranks.resize(points.len(), 0);
+        ranks.resize(count, 0);
         let domain = self.domain();
         let covered = ranks
             .par_iter_mut()
-            .zip(points.par_iter())
-            .map(|(r, p)| {
-                *r = self.rank(self.cell_of(p)) as u32;
-                inside(p, &domain)
+            .enumerate()
+            .map(|(i, r)| {
+                let p = at(i);
+                *r = self.rank(self.cell_of(&p)) as u32;
+                inside(&p, &domain)
             })
             .reduce(|| true, |a, b| a && b);
         let starts = &mut table.cell_start;
@@ -164,7 +187,7 @@ impl UniformGrid {
             starts[c + 1] += starts[c];
         }
         order.clear();
-        order.resize(points.len(), 0);
+        order.resize(count, 0);
         // Each cell's start serves as its cursor, which leaves it at the cell's end, the
         // next cell's start; shifting by one cell restores the starts.
         for (i, &r) in ranks.iter().enumerate() {
@@ -180,7 +203,7 @@ impl UniformGrid {
 
 /// Cell ranges produced by [`UniformGrid::sort`]: the points of the cell with Z-rank `c` are
 /// the sorted slots `cell_start[c]..cell_start[c + 1]`.
-#[derive(Clone, Debug, Default)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct CellTable {
     pub(super) cell_start: Vec<u32>,
     /// Scratch of the sort: the cell of every point.

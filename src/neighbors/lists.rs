@@ -1,8 +1,7 @@
-//! Neighbour lists in compressed (CSR) form, kept per block of queries; points by
-//! component; and the parallel walk over CSR segments.
+//! Neighbour lists in compressed (CSR) form, kept per block of queries, and the parallel
+//! walk over CSR segments.
 
-use super::BLOCK;
-use crate::Vec3;
+use super::{BLOCK, PointsByComponent};
 use crate::reserve::reserve_total;
 use rayon::prelude::*;
 use std::collections::TryReserveError;
@@ -126,93 +125,4 @@ pub fn par_segments_zip_mut<T: Send, U: Send>(
         }
     });
     Ok(())
-}
-
-/// Points by component (m): a structure of arrays, so that the distance tests of a cell's
-/// points run several lanes wide.
-#[derive(Clone, Debug, Default)]
-pub struct PointsByComponent {
-    pub(super) x: Vec<f64>,
-    pub(super) y: Vec<f64>,
-    pub(super) z: Vec<f64>,
-}
-
-impl PointsByComponent {
-    /// Replaces the contents with the points of `ranges` of `points` (`total` in all), in
-    /// that order; errors when memory for them cannot be had (the contents are then
-    /// unspecified).
-    pub(super) fn copy_ranges(
-        &mut self,
-        points: &PointsByComponent,
-        ranges: &[std::ops::Range<usize>],
-        total: usize,
-    ) -> Result<(), TryReserveError> {
-        for (out, from) in [
-            (&mut self.x, &points.x),
-            (&mut self.y, &points.y),
-            (&mut self.z, &points.z),
-        ] {
-            out.clear();
-            reserve_total(out, total)?;
-            for range in ranges {
-                out.extend_from_slice(&from[range.clone()]);
-            }
-        }
-        Ok(())
-    }
-
-    /// Point `i` (m).
-    #[inline]
-    pub fn at(&self, i: usize) -> Vec3 {
-        Vec3::new(self.x[i], self.y[i], self.z[i])
-    }
-
-    /// The number of points.
-    pub fn len(&self) -> usize {
-        self.x.len()
-    }
-
-    /// True when there are no points.
-    pub fn is_empty(&self) -> bool {
-        self.x.is_empty()
-    }
-
-    /// Makes these points a copy of `other`, reusing this one's storage; errors when memory
-    /// for them cannot be had (the contents are then unspecified).
-    pub(crate) fn try_copy_from(
-        &mut self,
-        other: &PointsByComponent,
-    ) -> Result<(), TryReserveError> {
-        for (out, from) in [
-            (&mut self.x, &other.x),
-            (&mut self.y, &other.y),
-            (&mut self.z, &other.z),
-        ] {
-            out.clear();
-            reserve_total(out, from.len())?;
-            out.extend_from_slice(from);
-        }
-        Ok(())
-    }
-
-    /// Reserves room for `points` points in all.
-    pub(crate) fn try_reserve(&mut self, points: usize) -> Result<(), TryReserveError> {
-        for c in [&mut self.x, &mut self.y, &mut self.z] {
-            reserve_total(c, points)?;
-        }
-        Ok(())
-    }
-
-    /// Replaces the contents with `points` (m), in one parallel pass; or, changing nothing,
-    /// errors when memory for them (24 bytes a point) cannot be had.
-    pub fn fill(&mut self, points: &[Vec3]) -> Result<(), TryReserveError> {
-        self.try_reserve(points.len())?;
-        for out in [&mut self.x, &mut self.y, &mut self.z] {
-            out.resize(points.len(), 0.0);
-        }
-        (&mut self.x[..], &mut self.y[..], &mut self.z[..], points)
-            .into_par_iter()
-            .for_each(|(x, y, z, p)| (*x, *y, *z) = (p.x, p.y, p.z));
-        Ok(())
-    }
 }

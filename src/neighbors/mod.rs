@@ -2,16 +2,19 @@
 //! particles by cell in Z-order (Morton order), and compressed (CSR) neighbour lists built in
 //! parallel. Every output depends only on the input positions, never on the thread count.
 //!
-//! [`UniformGrid`] sorts points by cell into a [`CellTable`] (`grid`) and searches them
-//! (`search`, with the AVX2 and AVX-512 builds in `avx`) into [`NeighborLists`] (`lists`).
+//! [`UniformGrid`] sorts points by cell into a [`CellTable`] (`grid`) and searches them, held
+//! by component ([`PointsByComponent`], `points`), (`search`, with the AVX2 and AVX-512
+//! builds in `avx`) into [`NeighborLists`] (`lists`).
 
 mod avx;
 mod grid;
 mod lists;
+mod points;
 mod search;
 
 pub use grid::{CellTable, UniformGrid};
-pub use lists::{NeighborLists, PointsByComponent, par_segments_zip_mut};
+pub use lists::{NeighborLists, par_segments_zip_mut};
+pub use points::PointsByComponent;
 
 /// Queries handled per parallel task; fixed so results never depend on the thread count.
 const BLOCK: usize = 256;

@@ -127,9 +127,13 @@ impl Line {
         let step = SCAN_STEP_SPACINGS * world.params().spacing();
         // Without a top the scan ends at the latest where no particle's kernel reaches.
         let ceiling = || {
-            let highest = (snapshot.fluid.iter().chain(&snapshot.boundary))
-                .map(|p| p.y)
-                .fold(f64::NEG_INFINITY, f64::max);
+            let highest = (snapshot
+                .fluid
+                .iter()
+                .copied()
+                .chain(snapshot.boundary.iter()))
+            .map(|p| p.y)
+            .fold(f64::NEG_INFINITY, f64::max);
             highest + world.params().support_radius()
         };
         let end = self.top.unwrap_or_else(ceiling).max(self.bottom);
@@ -193,7 +197,7 @@ fn fraction(
                 .map(|&j| kernel.w((p - s.fluid[j as usize]).norm()))
                 .sum();
             let walls: f64 = (boundary_lists.of(k).iter())
-                .map(|&b| s.psi[b as usize] * kernel.w((p - s.boundary[b as usize]).norm()))
+                .map(|&b| s.psi[b as usize] * kernel.w((p - s.boundary.at(b as usize)).norm()))
                 .sum();
             volume * fluid + walls / c.rest_density
         })

@@ -146,7 +146,7 @@ impl Field<'_> {
         if near.is_empty() {
             return f64::NAN;
         }
-        let at: Vec<Vec3> = near.iter().map(|&b| s.boundary[b as usize]).collect();
+        let at: Vec<Vec3> = near.iter().map(|&b| s.boundary.at(b as usize)).collect();
         s.fluid_near(&at, h, fluid);
         let volume = c.mass / c.rest_density;
         let stress: Vec3 = near

@@ -169,7 +169,7 @@ impl Coupling {
                 let near = boundary_lists.of(j);
                 let gradient = |k: u32| {
                     let k = k as usize;
-                    constraint.kernel.grad_w(&(s[j] - boundary.positions[k]))
+                    constraint.kernel.grad_w(&(s[j] - boundary.positions.at(k)))
                         * (boundary.psi[k] / constraint.rest_density)
                 };
                 let o = owners_near(near, owner_of, bodies)

@@ -6,7 +6,7 @@
 
 use super::StepBuffers;
 use crate::Vec3;
-use crate::boundary::{Aabb, Boundary};
+use crate::boundary::{Aabb, Boundary, BoundaryCopy};
 use crate::fluid::Fluid;
 use crate::kernel::CubicKernel;
 use crate::neighbors::UniformGrid;
@@ -97,9 +97,9 @@ impl SearchGrid {
     /// (re)built, with slack around the prediction `b.current` and the boundary, when there
     /// is none, when the boundary changed, or when `outgrown` (some of the prediction lies
     /// outside it) unless it already hit its cell limit; then outlying particles are clamped
-    /// into border cells, which stays correct. The grid and the boundary as they were are
-    /// kept in `b.undo` first. Errors when memory for the grid, the copy or the sort cannot
-    /// be had.
+    /// into border cells, which stays correct. The grid as it was, and what sorting the
+    /// boundary changes, are kept in `b.undo`. Errors when memory for the grid, the sort or
+    /// what is kept cannot be had.
     fn prepare(
         &mut self,
         pool: &rayon::ThreadPool,
@@ -112,10 +112,13 @@ impl SearchGrid {
         let (points, undo) = (&b.current, &mut b.undo);
         let outgrown = self.grid.is_none() || (outgrown && !self.capped);
         if outgrown || boundary.dirty {
-            let bounds = [points, &boundary.positions]
-                .iter()
-                .filter_map(|p| Aabb::around(p))
-                .reduce(|a, b| a.union(&b));
+            let bounds = [
+                Aabb::around(points),
+                Aabb::enclosing(boundary.positions.iter()),
+            ]
+            .into_iter()
+            .flatten()
+            .reduce(|a, b| a.union(&b));
             let Some(bounds) = bounds else {
                 return Ok(());
             };
@@ -134,7 +137,6 @@ impl SearchGrid {
             let grid =
                 UniformGrid::covering(finite(bounds.min - slack), finite(bounds.max + slack), h)?;
             let capped = !pool.install(|| grid.covers(points));
-            boundary.save(&mut undo.boundary)?;
             let replaced = std::mem::replace(
                 self,
                 SearchGrid {
@@ -144,26 +146,23 @@ impl SearchGrid {
             );
             // The grid from before the step, not one this step built and replaces again.
             undo.grid.get_or_insert(replaced);
-            boundary.dirty = true;
-        }
-        if boundary.dirty {
-            boundary.save(&mut undo.boundary)?;
-            self.sort_boundary(pool, params, kernel, boundary)?;
+            self.sort_boundary(pool, params, kernel, boundary, &mut undo.boundary)?;
         }
         Ok(())
     }
 
     /// Sorts `boundary` into the grid's cells with fresh Akinci masses (nothing without a
-    /// grid); errors as [`Boundary::sort`].
+    /// grid), keeping what it changes in `copy`; errors as [`Boundary::sort`].
     pub fn sort_boundary(
         &self,
         pool: &rayon::ThreadPool,
         params: &Params,
         kernel: &CubicKernel,
         boundary: &mut Boundary,
+        copy: &mut BoundaryCopy,
     ) -> Result<(), TryReserveError> {
         match &self.grid {
-            Some(grid) => pool.install(|| boundary.sort(grid, kernel, params.rest_density)),
+            Some(grid) => pool.install(|| boundary.sort(grid, kernel, params.rest_density, copy)),
             None => Ok(()),
         }
     }
@@ -215,7 +214,7 @@ pub(super) fn search(
     )?;
     grid.search_in(
         &boundary.table,
-        &boundary.by_component,
+        &boundary.positions,
         &b.current,
         h,
         false,

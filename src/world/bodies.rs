@@ -29,7 +29,7 @@ impl World {
         let bounds = spec.mesh.bounds();
         let size = bounds.max - bounds.min;
         let bound = sample_count_bound(&spec.mesh, r);
-        let total = self.boundary.positions.len() as f64
+        let total = self.boundary.len() as f64
             + self
                 .bodies
                 .iter()

@@ -112,7 +112,7 @@ impl World {
     /// particles and ([`Error::OutOfMemory`]) a shortage of memory without changing the world.
     pub fn add_boundary_particles(&mut self, positions: &[Vec3]) -> Result<(), Error> {
         check_finite("positions", positions)?;
-        if self.boundary.positions.len() + positions.len() > MAX_PARTICLES {
+        if self.boundary.len() + positions.len() > MAX_PARTICLES {
             return Err(Error::invalid(
                 "positions",
                 positions.len(),
@@ -155,7 +155,7 @@ impl World {
             ));
         }
         let expected = box_wall_sample_count(&container, r, layers);
-        if expected + self.boundary.positions.len() as f64 > MAX_PARTICLES as f64 {
+        if expected + self.boundary.len() as f64 > MAX_PARTICLES as f64 {
             return Err(Error::invalid(
                 "container",
                 format!("{:?}", size.as_slice()),
@@ -193,8 +193,11 @@ impl World {
         &mut self,
         additional: usize,
     ) -> Result<(), std::collections::TryReserveError> {
-        self.boundary.positions.try_reserve(additional)?;
-        self.boundary.owner.try_reserve(additional)
+        let boundary = &mut self.boundary;
+        boundary
+            .positions
+            .try_reserve(boundary.len() + additional)?;
+        boundary.owner.try_reserve(additional)
     }
 
     /// Adds a static obstacle: the surface of `mesh` (m) sampled by Poisson disk with a
@@ -218,7 +221,7 @@ impl World {
         }
         let bound = sample_count_bound(mesh, r);
         if !(bound <= MAX_MESH_SAMPLES
-            && bound + self.boundary.positions.len() as f64 <= MAX_PARTICLES as f64)
+            && bound + self.boundary.len() as f64 <= MAX_PARTICLES as f64)
         {
             return Err(Error::invalid(
                 "mesh",

@@ -178,7 +178,7 @@ impl World {
 
     /// Number of boundary particles.
     pub fn boundary_count(&self) -> usize {
-        self.boundary.positions.len()
+        self.boundary.len()
     }
 
     /// Simulated time (s).

@@ -65,9 +65,10 @@ impl World {
     }
 
     /// Boundary particle positions (m), in the world's storage order: walls, obstacles and
-    /// static bodies, and the moving bodies' particles where the last step placed them.
-    pub fn boundary_positions(&self) -> &[Vec3] {
-        &self.boundary.positions
+    /// static bodies, and the moving bodies' particles where the last step placed them. A
+    /// copy: the world keeps them by component.
+    pub fn boundary_positions(&self) -> Vec<Vec3> {
+        self.boundary.positions.to_vec()
     }
 
     /// Every boundary particle where it is now (m): the static ones, then each moving body's

@@ -27,10 +27,8 @@ pub(crate) struct Snapshot {
     pub fluid_components: PointsByComponent,
     /// Where each cell's boundary particles lie in `boundary`.
     pub boundary_table: CellTable,
-    /// Boundary positions (m), in the order of `boundary_table`.
-    pub boundary: Vec<Vec3>,
-    /// `boundary` by component, for searches among them.
-    pub boundary_components: PointsByComponent,
+    /// Boundary positions (m), in the order of `boundary_table`, by component.
+    pub boundary: PointsByComponent,
     /// Akinci mass ψ_b = ρ0·V_b (kg) of each of `boundary` (docs/method.md §2.6).
     pub psi: Vec<f64>,
 }
@@ -48,7 +46,7 @@ impl Snapshot {
     /// For every query point, the boundary particles within the support radius `h` (m), as
     /// indices into `boundary`, ascending.
     pub fn boundary_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
-        let (table, points) = (&self.boundary_table, &self.boundary_components);
+        let (table, points) = (&self.boundary_table, &self.boundary);
         self.grid
             .search_in(table, points, queries, h, false, out)
             .expect(OUT_OF_MEMORY);
@@ -64,28 +62,30 @@ impl World {
         let h = self.params.support_radius();
         let fluid = &self.fluid.positions;
         let boundary = &self.boundary;
-        let bounds = [fluid.as_slice(), &boundary.positions]
-            .iter()
-            .filter_map(|p| Aabb::around(p))
-            .reduce(|a, b| a.union(&b))?;
+        let bounds = [
+            Aabb::around(fluid),
+            Aabb::enclosing(boundary.positions.iter()),
+        ]
+        .into_iter()
+        .flatten()
+        .reduce(|a, b| a.union(&b))?;
         let grid = UniformGrid::covering(bounds.min, bounds.max, h).expect(OUT_OF_MEMORY);
-        let sorted = |points: &[Vec3], table: &mut CellTable| {
-            let mut order = Vec::new();
-            grid.sort(points, &mut order, table).expect(OUT_OF_MEMORY);
-            order
-        };
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
-        let fluid_order = sorted(fluid, &mut fluid_table);
-        let boundary_order = sorted(&boundary.positions, &mut boundary_table);
+        let (mut fluid_order, mut boundary_order) = (Vec::new(), Vec::new());
+        grid.sort(fluid, &mut fluid_order, &mut fluid_table)
+            .expect(OUT_OF_MEMORY);
+        grid.sort_by_component(
+            &boundary.positions,
+            &mut boundary_order,
+            &mut boundary_table,
+        )
+        .expect(OUT_OF_MEMORY);
         let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
-        let bx: Vec<Vec3> = boundary_order
-            .iter()
-            .map(|&i| boundary.positions[i as usize])
-            .collect();
-        let (mut fluid_components, mut boundary_components) =
+        let (mut fluid_components, mut bx) =
             (PointsByComponent::default(), PointsByComponent::default());
         fluid_components.fill(&fluid).expect(OUT_OF_MEMORY);
-        boundary_components.fill(&bx).expect(OUT_OF_MEMORY);
+        bx.try_permuted_from(&boundary.positions, &boundary_order)
+            .expect(OUT_OF_MEMORY);
         let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
             boundary_order
                 .iter()
@@ -93,7 +93,7 @@ impl World {
                 .collect()
         } else {
             let kernel = &self.constraint.kernel;
-            akinci_volumes(&grid, &boundary_table, &bx, &boundary_components, kernel)
+            akinci_volumes(&grid, &boundary_table, &bx, kernel)
                 .expect(OUT_OF_MEMORY)
                 .into_iter()
                 .map(|v| v * self.params.rest_density)
@@ -107,7 +107,6 @@ impl World {
             fluid_components,
             boundary_table,
             boundary: bx,
-            boundary_components,
             psi,
         })
     }

@@ -9,7 +9,7 @@
 
 use super::World;
 use crate::body::BodyState;
-use crate::boundary::{Aabb, WALLS};
+use crate::boundary::{Aabb, BoundaryCopy, WALLS};
 use crate::emitter::{Emitter, EmitterState};
 use crate::neighbors::UniformGrid;
 use crate::solver::OnlineRho;
@@ -217,10 +217,11 @@ impl World {
         // shortage of memory changes nothing.
         let mut boundary = self
             .boundary
-            .with_statics(state.boundary_positions, state.boundary_owners);
+            .with_statics(&state.boundary_positions, state.boundary_owners)
+            .map_err(oom)?;
         if state.boundary_sorted {
-            let kernel = &self.constraint.kernel;
-            grid.sort_boundary(&self.pool, &self.params, kernel, &mut boundary)
+            let (kernel, copy) = (&self.constraint.kernel, &mut BoundaryCopy::default());
+            grid.sort_boundary(&self.pool, &self.params, kernel, &mut boundary, copy)
                 .map_err(oom)?;
         }
         let fluid = &mut self.fluid;

@@ -164,12 +164,14 @@ pub(super) unsafe fn push_within_avx512<const SPARSE: bool>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::neighbors::search::Searched;
     use crate::neighbors::test_points::{random_points, sorted_copy};
     use crate::neighbors::{CellTable, PointsByComponent, UniformGrid};
 
     /// Every build of the block search (portable, AVX2, AVX-512, as far as the processor
-    /// has them) finds the same lists, with and without skipping the query itself, on
-    /// points with dense clumps (several vectors and a partial one per candidate run).
+    /// has them) finds the same lists, with and without skipping the query itself, among
+    /// points by component and as vectors, on points with dense clumps (several vectors and
+    /// a partial one per candidate run).
     #[test]
     fn search_builds_find_the_same_lists() {
         let radius = 0.1;
@@ -184,11 +186,16 @@ mod tests {
         let sorted = sorted_copy(&grid, &pts, &mut table);
         let mut points = PointsByComponent::default();
         points.fill(&sorted).unwrap();
-        for exclude_self in [None, Some(0)] {
+        let forms = [Searched::Components(&points), Searched::Vectors(&sorted)];
+        let mut lists = Vec::new();
+        for (exclude_self, points) in [None, Some(0)]
+            .into_iter()
+            .flat_map(|e| forms.map(|p| (e, p)))
+        {
             let block = Block {
                 grid: &grid,
                 table: &table,
-                points: &points,
+                points,
                 r2: radius * radius,
                 exclude_self,
             };
@@ -206,13 +213,16 @@ mod tests {
                     let avx2 = run(&|c, f| unsafe { block.search_avx2(&sorted, c, f).unwrap() });
                     assert_eq!(avx2, reference, "AVX2 build");
                 }
-                if crate::simd::has_avx512() {
+                if crate::simd::has_avx512() && matches!(points, Searched::Components(_)) {
                     // SAFETY: the processor has the AVX-512 subsets.
                     let avx512 =
                         run(&|c, f| unsafe { block.search_avx512(&sorted, c, f).unwrap() });
                     assert_eq!(avx512, reference, "AVX-512 build");
                 }
             }
+            lists.push(reference);
         }
+        assert_eq!(lists[0], lists[1], "points by component and as vectors");
+        assert_eq!(lists[2], lists[3], "points by component and as vectors");
     }
 }

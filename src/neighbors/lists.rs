@@ -1,7 +1,7 @@
 //! Neighbour lists in compressed (CSR) form, kept per block of queries, and the parallel
 //! walk over CSR segments.
 
-use super::{BLOCK, PointsByComponent};
+use super::BLOCK;
 use crate::reserve::reserve_total;
 use rayon::prelude::*;
 use std::collections::TryReserveError;
@@ -16,10 +16,6 @@ pub struct NeighborLists {
     /// Per block of queries: where each query's list starts in the block's concatenated
     /// lists (one more entry than queries), and those lists.
     pub(super) blocks: Vec<(Vec<u32>, Vec<u32>)>,
-    /// The searched points by component, for [`UniformGrid::search`].
-    ///
-    /// [`UniformGrid::search`]: super::UniformGrid::search
-    pub(super) coordinates: PointsByComponent,
 }
 
 impl NeighborLists {
@@ -47,14 +43,6 @@ impl NeighborLists {
     /// True when there are no queries.
     pub fn is_empty(&self) -> bool {
         self.len() == 0
-    }
-
-    /// The points searched by the last [`UniformGrid::search`] into these lists, by
-    /// component (m).
-    ///
-    /// [`UniformGrid::search`]: super::UniformGrid::search
-    pub fn searched_points(&self) -> &PointsByComponent {
-        &self.coordinates
     }
 
     /// The number of neighbours of all queries together (pairs found).
@@ -90,7 +78,7 @@ impl NeighborLists {
         for (starts, _) in &mut self.blocks[..blocks] {
             reserve_total(starts, BLOCK + 1)?;
         }
-        self.coordinates.try_reserve(queries)
+        Ok(())
     }
 }
 

@@ -39,6 +39,30 @@ impl PointsByComponent {
         Ok(())
     }
 
+    /// [`PointsByComponent::copy_ranges`] of points held as vectors (m).
+    pub(super) fn copy_vector_ranges(
+        &mut self,
+        points: &[Vec3],
+        ranges: &[std::ops::Range<usize>],
+        total: usize,
+    ) -> Result<(), TryReserveError> {
+        self.clear();
+        self.try_reserve(total)?;
+        for range in ranges {
+            for p in &points[range.clone()] {
+                self.push(*p);
+            }
+        }
+        Ok(())
+    }
+
+    /// Removes every point, keeping the storage.
+    pub(crate) fn clear(&mut self) {
+        for c in [&mut self.x, &mut self.y, &mut self.z] {
+            c.clear();
+        }
+    }
+
     /// Point `i` (m).
     #[inline]
     pub fn at(&self, i: usize) -> Vec3 {

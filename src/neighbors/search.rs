@@ -14,6 +14,26 @@ use std::collections::TryReserveError;
 /// stores whole ([`push_within_avx512`]).
 const STORE_SLACK: usize = 8;
 
+/// The points a search looks among, in the order of its table.
+#[derive(Clone, Copy)]
+pub(super) enum Searched<'a> {
+    /// Held by component: tested where they lie by the AVX-512 build (points searched many
+    /// times, such as the boundary's).
+    Components(&'a PointsByComponent),
+    /// Held as vectors: copied by component a cell's neighbourhood at a time (points searched
+    /// once, such as the fluid's prediction, which then needs no copy of its own).
+    Vectors(&'a [Vec3]),
+}
+
+impl Searched<'_> {
+    fn len(&self) -> usize {
+        match self {
+            Searched::Components(p) => p.len(),
+            Searched::Vectors(p) => p.len(),
+        }
+    }
+}
+
 impl UniformGrid {
     /// For every query point, the indices of `points` (already in the order of `table`) within
     /// `radius` (≤ cell size), sorted ascending. With `exclude_self`, query i skips point i.
@@ -21,6 +41,9 @@ impl UniformGrid {
     /// The lists reuse the storage `out` had and grow, through fallible reservations, where
     /// it is short: when memory runs out the search stops with the error, and `out` then
     /// answers for no query until it is searched again.
+    ///
+    /// # Panics
+    /// If `points` and `table` differ in length, or `radius` exceeds the cell size.
     pub fn search(
         &self,
         table: &CellTable,
@@ -30,20 +53,15 @@ impl UniformGrid {
         exclude_self: bool,
         out: &mut NeighborLists,
     ) -> Result<(), TryReserveError> {
-        let mut coordinates = std::mem::take(&mut out.coordinates);
-        let searched = coordinates
-            .fill(points)
-            .and_then(|()| self.search_in(table, &coordinates, queries, radius, exclude_self, out));
-        out.coordinates = coordinates;
-        searched
+        let (points, first) = (Searched::Vectors(points), exclude_self.then_some(0));
+        self.search_among(table, points, queries, first, radius, out)
     }
 
-    /// [`UniformGrid::search`] among `points` already copied by component (for points that
-    /// do not move, such as the boundary's, copied once): they must be the points `table`
-    /// sorted, in its order.
+    /// [`UniformGrid::search`] among `points` held by component (for points searched many
+    /// times, such as the boundary's, which the AVX-512 build tests where they lie).
     ///
     /// # Panics
-    /// If `points` and `table` differ in length, or `radius` exceeds the cell size.
+    /// As [`UniformGrid::search`].
     pub fn search_in(
         &self,
         table: &CellTable,
@@ -70,12 +88,26 @@ impl UniformGrid {
         radius: f64,
         out: &mut NeighborLists,
     ) -> Result<(), TryReserveError> {
+        let points = Searched::Components(points);
+        self.search_among(table, points, queries, first_self, radius, out)
+    }
+
+    /// The search of [`UniformGrid::search_from`] among points in either form.
+    fn search_among(
+        &self,
+        table: &CellTable,
+        points: Searched,
+        queries: &[Vec3],
+        first_self: Option<usize>,
+        radius: f64,
+        out: &mut NeighborLists,
+    ) -> Result<(), TryReserveError> {
         assert!(
             radius <= self.cell_size,
             "search radius exceeds the cell size"
         );
         assert_eq!(
-            points.x.len(),
+            points.len(),
             table.point_count(),
             "search: not the points the table sorted"
         );
@@ -121,7 +153,7 @@ impl UniformGrid {
 pub(super) struct Block<'a> {
     pub(super) grid: &'a UniformGrid,
     pub(super) table: &'a CellTable,
-    pub(super) points: &'a PointsByComponent,
+    pub(super) points: Searched<'a>,
     /// Squared search radius (m²).
     pub(super) r2: f64,
     /// With `Some(first)`, query k of the block is point `first + k` and skips itself.
@@ -131,9 +163,9 @@ pub(super) struct Block<'a> {
 impl Block<'_> {
     /// Replaces `found` with the neighbours of every query, one list after another, and
     /// `starts` with where each list starts there (and, last, where the last one ends): eight
-    /// distance tests per instruction in the AVX-512 build, four in the AVX2 build, the same
-    /// lists from every build (tested). Errors when the lists need more memory than can be
-    /// had.
+    /// distance tests per instruction in the AVX-512 build (among points by component), four
+    /// in the AVX2 build, the same lists from every build (tested). Errors when the lists
+    /// need more memory than can be had.
     fn search(
         &self,
         queries: &[Vec3],
@@ -141,7 +173,7 @@ impl Block<'_> {
         found: &mut Vec<u32>,
     ) -> Result<(), TryReserveError> {
         #[cfg(target_arch = "x86_64")]
-        if crate::simd::has_avx512() {
+        if matches!(self.points, Searched::Components(_)) && crate::simd::has_avx512() {
             // SAFETY: the processor supports the build's features, checked just above.
             return unsafe { self.search_avx512(queries, starts, found) };
         }
@@ -161,10 +193,10 @@ impl Block<'_> {
     }
 
     /// The body of [`Block::search`]. With `AVX512` (only instantiated so by
-    /// [`Block::search_avx512`]) the candidates are tested where they lie, eight lanes wide,
-    /// and the neighbours found are compressed into `found` a vector at a time, skipping
-    /// candidates by groups with `SPARSE` ([`push_within_avx512`]); without, they are first
-    /// copied into one run.
+    /// [`Block::search_avx512`], for points by component) the candidates are tested where
+    /// they lie, eight lanes wide, and the neighbours found are compressed into `found` a
+    /// vector at a time, skipping candidates by groups with `SPARSE` ([`push_within_avx512`]);
+    /// without, they are first copied into one run.
     ///
     /// A query finds at most its candidates, the points of its cell and the adjacent ones;
     /// room for that many (and one vector more) is made before each query, fallibly, so
@@ -178,7 +210,11 @@ impl Block<'_> {
         found: &mut Vec<u32>,
     ) -> Result<(), TryReserveError> {
         let grid = self.grid;
-        let p = self.points;
+        // The points the AVX-512 build tests where they lie.
+        let in_place = match self.points {
+            Searched::Components(p) if AVX512 => Some(p),
+            _ => None,
+        };
         starts.clear();
         reserve_total(starts, queries.len() + 1)?;
         starts.push(0);
@@ -234,7 +270,12 @@ impl Block<'_> {
                         }
                         ranges = runs;
                     } else {
-                        if let Err(e) = candidates.copy_ranges(p, &near[..ranges], total) {
+                        let near = &near[..ranges];
+                        let copied = match self.points {
+                            Searched::Components(p) => candidates.copy_ranges(p, near, total),
+                            Searched::Vectors(p) => candidates.copy_vector_ranges(p, near, total),
+                        };
+                        if let Err(e) = copied {
                             break 'search Err(e);
                         }
                         ids.clear();
@@ -253,6 +294,9 @@ impl Block<'_> {
                 }
                 #[cfg(target_arch = "x86_64")]
                 if AVX512 {
+                    let Some(p) = in_place else {
+                        unreachable!("the AVX-512 build searches points by component only")
+                    };
                     let own = self.exclude_self.map(|first| first + k);
                     let ranges = &near[..ranges];
                     // SAFETY: `AVX512` is set only by `search_avx512`, which runs where the

@@ -19,10 +19,11 @@
 //! grown fallibly as a step starts, so that a step short of memory for it fails before it
 //! moves the fluid (docs/method.md §1.3).
 
+use super::search::Prediction;
 use crate::Vec3;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Projection};
-use crate::neighbors::{NeighborLists, PointsByComponent};
+use crate::neighbors::NeighborLists;
 use crate::reserve::reserve_total;
 use crate::solver::Chebyshev;
 use rayon::prelude::*;
@@ -235,10 +236,10 @@ impl Coupling {
     /// step size `dt` (s), for particles of mass `mass` (kg): `out[o]` for body o, and
     /// `out[bodies]` for the walls and obstacles, which take the rest of the momentum the
     /// fluid exchanged in the step, K = −(m/Δt²) Σ_j (x_j − s_j), and of its moment.
-    pub fn loads(
+    pub(super) fn loads(
         &mut self,
         mass: f64,
-        s: &PointsByComponent,
+        s: &Prediction,
         x: &[Vec3],
         dt: f64,
         out: &mut Vec<Load>,

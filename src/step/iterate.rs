@@ -4,9 +4,11 @@
 //! compression is at most η (once no particle moves farther than 10τ) or no particle moved
 //! farther than τ.
 
+use super::search::Prediction;
 use super::{StepBuffers, couple};
 use crate::boundary::Boundary;
 use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection};
+use crate::fluid::Fluid;
 use crate::params::{Params, SolverKind};
 use crate::solver::{Chebyshev, GlobalSolver, Sweep};
 use crate::stats::StepTimings;
@@ -26,6 +28,10 @@ pub(super) struct Iteration<'a> {
     pub params: &'a Params,
     pub constraint: &'a DensityConstraint,
     pub boundary: &'a Boundary,
+    /// The fluid as the step found it, in its order from before the step's sort.
+    pub fluid: &'a Fluid,
+    /// g (m/s²).
+    pub gravity: Vec3,
     pub solver: &'a mut dyn GlobalSolver,
     pub chebyshev: &'a mut Chebyshev,
     /// Step size (s).
@@ -64,6 +70,8 @@ pub(super) fn iterate(
         params,
         constraint,
         boundary,
+        fluid,
+        gravity,
         solver,
         chebyshev,
         dt,
@@ -132,7 +140,8 @@ pub(super) fn iterate(
             });
         }
         let (projections, corrections) = (&b.projections, &b.corrections);
-        let (current, predicted) = (&b.current, b.fluid_lists.searched_points());
+        let current = &b.current;
+        let predicted = Prediction::new(fluid, Some(&b.order), dt, gravity);
         // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
         // for the particles of chunk `chunk`.
         let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {

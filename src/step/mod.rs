@@ -148,6 +148,8 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 params,
                 constraint,
                 boundary,
+                fluid,
+                gravity,
                 solver,
                 chebyshev,
                 dt,
@@ -173,7 +175,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
         timings.neighbors += t.elapsed().as_secs_f64();
         if couple {
             let loads = &mut buffers.loads;
-            let predicted = buffers.fluid_lists.searched_points();
+            let predicted = &search::Prediction::new(fluid, None, dt, gravity);
             buffers
                 .coupling
                 .loads(constraint.mass, predicted, &buffers.current, dt, loads);

@@ -62,8 +62,8 @@ impl StepBuffers {
     }
 }
 
-/// The inertial prediction s = x + Δt v + Δt² g (m), into `s` (the buffer of X^(0); the
-/// search keeps a copy by component, which serves where s is read later).
+/// The inertial prediction s = x + Δt v + Δt² g (m), into `s` (the buffer of X^(0); where
+/// s is read later, it is evaluated again, [`Prediction`]).
 pub(super) fn predict(
     pool: &rayon::ThreadPool,
     fluid: &Fluid,
@@ -75,8 +75,53 @@ pub(super) fn predict(
         s.resize(fluid.len(), Vec3::zeros());
         s.par_iter_mut()
             .zip(fluid.positions.par_iter().zip(fluid.velocities.par_iter()))
-            .for_each(|(s, (x, v))| *s = x + v * dt + gravity * (dt * dt));
+            .for_each(|(s, (x, v))| *s = predicted(x, v, dt, gravity));
     });
+}
+
+/// s = x + Δt v + Δt² g (m) of a particle at `x` (m) moving at `v` (m/s), over `dt` (s)
+/// under `gravity` (m/s²): the one expression of the prediction, so that s comes out bit
+/// for bit the same wherever it is evaluated.
+#[inline(always)]
+fn predicted(x: &Vec3, v: &Vec3, dt: f64, gravity: Vec3) -> Vec3 {
+    x + v * dt + gravity * (dt * dt)
+}
+
+/// The inertial prediction s of the step (m), evaluated where it is read rather than kept:
+/// from the fluid's positions and velocities, which the step leaves as they are until it can
+/// no longer fail.
+#[derive(Clone, Copy)]
+pub(super) struct Prediction<'a> {
+    fluid: &'a Fluid,
+    /// The sort's order, while the fluid's arrays are not yet in it: slot k of the sort then
+    /// holds particle `order[k]`.
+    order: Option<&'a [u32]>,
+    /// Δt (s).
+    dt: f64,
+    /// g (m/s²).
+    gravity: Vec3,
+}
+
+impl<'a> Prediction<'a> {
+    /// The prediction of `fluid` over `dt` (s) under `gravity` (m/s²), its slots in the
+    /// order `order` of the step's sort, or in the fluid's own with `None` (once the fluid
+    /// is sorted).
+    pub fn new(fluid: &'a Fluid, order: Option<&'a [u32]>, dt: f64, gravity: Vec3) -> Self {
+        Prediction {
+            fluid,
+            order,
+            dt,
+            gravity,
+        }
+    }
+
+    /// s of the particle in slot `k` of the sort (m).
+    #[inline]
+    pub fn at(&self, k: usize) -> Vec3 {
+        let i = self.order.map_or(k, |order| order[k] as usize);
+        let f = self.fluid;
+        predicted(&f.positions[i], &f.velocities[i], self.dt, self.gravity)
+    }
 }
 
 /// The grid's slack on every side, as a fraction of the extent of what it covers: room for

@@ -23,8 +23,6 @@ pub(crate) struct Snapshot {
     pub fluid: Vec<Vec3>,
     /// The storage index in the world of the particle at each of `fluid`.
     pub fluid_order: Vec<u32>,
-    /// `fluid` by component, for searches among them.
-    pub fluid_components: PointsByComponent,
     /// Where each cell's boundary particles lie in `boundary`.
     pub boundary_table: CellTable,
     /// Boundary positions (m), in the order of `boundary_table`, by component.
@@ -37,9 +35,9 @@ impl Snapshot {
     /// For every query point, the fluid particles within the support radius `h` (m), as
     /// indices into `fluid`, ascending.
     pub fn fluid_near(&self, queries: &[Vec3], h: f64, out: &mut NeighborLists) {
-        let (table, points) = (&self.fluid_table, &self.fluid_components);
+        let (table, points) = (&self.fluid_table, &self.fluid);
         self.grid
-            .search_in(table, points, queries, h, false, out)
+            .search(table, points, queries, h, false, out)
             .expect(OUT_OF_MEMORY);
     }
 
@@ -81,9 +79,7 @@ impl World {
         )
         .expect(OUT_OF_MEMORY);
         let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
-        let (mut fluid_components, mut bx) =
-            (PointsByComponent::default(), PointsByComponent::default());
-        fluid_components.fill(&fluid).expect(OUT_OF_MEMORY);
+        let mut bx = PointsByComponent::default();
         bx.try_permuted_from(&boundary.positions, &boundary_order)
             .expect(OUT_OF_MEMORY);
         let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
@@ -104,7 +100,6 @@ impl World {
             fluid_table,
             fluid,
             fluid_order,
-            fluid_components,
             boundary_table,
             boundary: bx,
             psi,

@@ -27,6 +27,7 @@ pub mod io;
 pub mod kernel;
 pub mod neighbors;
 pub mod params;
+mod permutation;
 pub mod pressure;
 pub mod probe;
 mod random;

@@ -7,11 +7,12 @@
 //! the masses computed in their own frames, and sorted in among the static ones.
 
 use super::WALLS;
-use super::undo::{BoundaryCopy, permute_in_place};
+use super::undo::BoundaryCopy;
 use crate::Vec3;
 use crate::boundary::akinci_volumes;
 use crate::kernel::CubicKernel;
 use crate::neighbors::{CellTable, PointsByComponent, UniformGrid};
+use crate::permutation::permute_in_place;
 use crate::reserve::reserve_total;
 use std::collections::TryReserveError;
 

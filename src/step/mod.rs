@@ -56,7 +56,6 @@ pub(crate) struct StepBuffers {
     /// The projection weight w_j of every fluid particle.
     weights: Vec<f64>,
     system: DiagonalSystem,
-    scratch_ids: Vec<u64>,
     /// δ_k of every outer iteration of the last step (m).
     pub(crate) displacements: Vec<f64>,
     /// The boundary's share of the fluid's displacement, in worlds with bodies.

@@ -11,6 +11,7 @@ use crate::fluid::Fluid;
 use crate::kernel::CubicKernel;
 use crate::neighbors::UniformGrid;
 use crate::params::Params;
+use crate::permutation::permute_in_place;
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
@@ -43,7 +44,6 @@ impl StepBuffers {
         reserve_total(&mut self.order, fluid)?;
         reserve_total(&mut self.weights, fluid)?;
         reserve_total(&mut self.system.diagonal, fluid)?;
-        reserve_total(&mut self.scratch_ids, fluid)?;
         reserve_total(&mut self.displacements, iterations)?;
         self.table.try_reserve(fluid, 0)?;
         self.corrections.try_reserve(fluid)?;
@@ -268,11 +268,12 @@ pub(super) fn search(
 }
 
 /// Reorders the fluid's own arrays by the sort's order, as [`search`] reordered s: once the
-/// step can no longer fail. X^(k−1) of the finished iteration serves as the scratch.
+/// step can no longer fail. X^(k−1) of the finished iteration serves as the scratch of the
+/// positions and velocities; the ids are reordered in place.
 pub(super) fn permute_fluid(fluid: &mut Fluid, b: &mut StepBuffers) {
     permute(&b.order, &mut fluid.positions, &mut b.previous);
     permute(&b.order, &mut fluid.velocities, &mut b.previous);
-    permute(&b.order, &mut fluid.ids, &mut b.scratch_ids);
+    permute_in_place(&mut b.order, |a, c| fluid.ids.swap(a, c));
 }
 
 /// Reorders `data` so that slot k holds the old `data[order[k]]`.

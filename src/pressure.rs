@@ -67,12 +67,10 @@ impl World {
         c.gathered_corrections(0, x, nb, &projections, &corrections, &mut gathered);
         let force_sum: f64 = gathered.iter().map(|p| p.y).sum();
         let support = force_sum * params.stiffness / x.len().max(1) as f64;
-        let pressures = projections
-            .iter()
-            .enumerate()
-            .map(|(i, proj)| {
+        let pressures = (0..x.len())
+            .map(|i| {
                 let weight = c.membership(nb.fluid, i);
-                -params.stiffness * proj.lambda * weight / volume
+                -params.stiffness * corrections.lambda(i) * weight / volume
             })
             .collect();
         (pressures, support)

@@ -3,7 +3,7 @@
 //! density (docs/method.md §2.5).
 
 use super::stencil::{Scratch, members_sum, ordered_dot, padded};
-use super::{DensityConstraint, Neighborhood, Projection, RELAXATION_MARGIN};
+use super::{DensityConstraint, Neighborhood, RELAXATION_MARGIN};
 use crate::Vec3;
 
 impl DensityConstraint {
@@ -56,13 +56,17 @@ impl DensityConstraint {
         (grad_i, members_sum(&m.values, n) + grad_i.norm_squared())
     }
 
-    /// ρ_i after the first projection step `first` (λ and the centre's correction), from the
-    /// offsets kept by [`Self::first_density`] and the gradients and weights of
+    /// ρ_i after the first projection step, of multiplier `lambda` (m²) and centre correction
+    /// `shift` (m), from the offsets kept by [`Self::first_density`] and the gradients and weights of
     /// [`Self::first_gradients`]: p_i − p_j = (x_i − x_j) + Δp_i − λ w_j ∇_{x_j}C_i.
     #[inline(always)]
-    pub(super) fn first_step_density(&self, first: &Projection, scratch: &mut Scratch) -> f64 {
+    pub(super) fn first_step_density(
+        &self,
+        lambda: f64,
+        shift: Vec3,
+        scratch: &mut Scratch,
+    ) -> f64 {
         let k = &self.kernel;
-        let (lambda, shift) = (first.lambda, first.self_correction);
         let m = &mut scratch.members;
         for ((((((w, weight), gx), gy), gz), rx), (ry, rz)) in m.values[..padded(m.n)]
             .iter_mut()
@@ -143,7 +147,6 @@ impl DensityConstraint {
 
 #[cfg(test)]
 mod tests {
-    use super::*;
     use crate::constraint::stencil::Scratch;
     use crate::constraint::test_cluster::{cluster, test_constraint};
     use crate::constraint::{CONSTRAINT_GOAL, REGULARIZATION};
@@ -178,14 +181,10 @@ mod tests {
                 let (grad_i, denominator) = constraint.first_gradients(i, &nb, &mut scratch);
                 let lambda = -c / (denominator + REGULARIZATION);
                 let w_i = constraint.weight_of(&nb, i);
-                let first = Projection {
-                    lambda,
-                    self_correction: grad_i * (lambda * w_i),
-                    ..Projection::default()
-                };
+                let shift = grad_i * (lambda * w_i);
                 if constraint.first_step_surely_relaxes(rho, lambda, grad_i, w_i, &mut scratch) {
                     certified += 1;
-                    let after = constraint.first_step_density(&first, &mut scratch);
+                    let after = constraint.first_step_density(lambda, shift, &mut scratch);
                     assert!(
                         after <= constraint.rest_density,
                         "spacing factor {factor}, particle {i}: ρ {after} after the step"

@@ -19,12 +19,13 @@ pub struct Corrections {
     /// Segment k spans `data[offsets[k]..offsets[k + 1]]`.
     pub(super) offsets: Vec<u32>,
     pub(super) data: Vec<Vec3>,
-    /// λ_i of every single-step projection, 0 for the others (inactive or kept), in a
-    /// compact array (8 bytes per particle, against 40 for a [`Projection`]): the gather
-    /// reads it for every neighbour that `moved` marks.
+    /// λ_i of every projection's first step, 0 for an inactive constraint, in a compact array
+    /// (8 bytes per particle, against 40 for a [`Projection`]): the gather reads it for
+    /// every neighbour that `moved` marks.
     pub(super) lambdas: Vec<f64>,
-    /// 1 where `lambdas` is not 0: one byte per particle, so that the gather's scan of a
-    /// particle's neighbours reads an array that stays in the nearest cache.
+    /// 1 where a single-step projection moved its stencil (λ not 0): one byte per particle,
+    /// so that the gather's scan of a particle's neighbours reads an array that stays in the
+    /// nearest cache.
     pub(super) moved: Vec<u8>,
     /// Whether particle j is a member of a stencil whose projection kept a segment: only
     /// then does its gather look for segments.
@@ -50,6 +51,12 @@ impl Corrections {
     /// How many projections of the last local step kept their corrections.
     pub fn kept(&self) -> usize {
         self.owners.len()
+    }
+
+    /// λ of the first step of projection i in the last local step (m²; 0 for an inactive
+    /// constraint).
+    pub fn lambda(&self, i: usize) -> f64 {
+        self.lambdas[i]
     }
 
     /// P_{i,j} − x_j (m) from the segment that projection i kept (out of the gather's hot

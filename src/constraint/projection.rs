@@ -13,12 +13,10 @@ use crate::reserve::reserve_total;
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
-/// What the local step of one constraint produced.
+/// What the local step of one constraint produced, besides the λ of its first step (kept in
+/// [`Corrections`], [`Corrections::lambda`]).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Projection {
-    /// λ of a projection that ended after one step (0 for an inactive constraint), in m²…
-    /// units of C/|∇C|², i.e. m².
-    pub lambda: f64,
     /// The correction of the constraint's own particle, P_{i,i} − x_i (m).
     pub self_correction: Vec3,
     /// The neighbours' corrections were written out (multi-step projection), to the segment
@@ -74,9 +72,8 @@ impl DensityConstraint {
                         if dp.len() < members {
                             dp.resize(members, Vec3::zeros());
                         }
-                        self.project_one(i, x, nb, &mut dp[..members], out, scratch);
-                        *lambda = if out.materialized { 0.0 } else { out.lambda };
-                        *moved = u8::from(*lambda != 0.0);
+                        *lambda = self.project_one(i, x, nb, &mut dp[..members], out, scratch);
+                        *moved = u8::from(*lambda != 0.0 && !out.materialized);
                         kept += usize::from(out.materialized);
                     }
                     scratch.dp = dp;
@@ -194,10 +191,11 @@ impl DensityConstraint {
 
     crate::simd::avx2_dispatch! {
         /// Projection of constraint i (docs/method.md §2.5): Newton-like steps on a private
-        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14. A projection that ends after
-        /// its first step is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]`
-        /// (s-th neighbour) receive the corrections. The AVX2 build runs the loops over a
-        /// stencil's members four lanes wide, bitwise alike (tested).
+        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14; returns the first step's λ
+        /// (m², 0 for an inactive constraint). A projection that ends after its first step
+        /// is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour)
+        /// receive the corrections. The AVX2 build runs the loops over a stencil's members
+        /// four lanes wide, bitwise alike (tested).
         fn project_one / project_one_avx2(
             &self,
             i: usize,
@@ -206,7 +204,7 @@ impl DensityConstraint {
             dp: &mut [Vec3],
             out: &mut Projection,
             scratch: &mut Scratch,
-        ) where !self.portable => project_one_portable
+        ) -> f64 where !self.portable => project_one_portable
     }
 
     /// The body of [`Self::project_one`], inlined into both builds.
@@ -219,8 +217,9 @@ impl DensityConstraint {
         dp: &mut [Vec3],
         out: &mut Projection,
         scratch: &mut Scratch,
-    ) {
+    ) -> f64 {
         *out = Projection::default();
+        let mut first_lambda = 0.0;
         let members = nb.fluid.of(i);
         let at = |s: usize| x[members[s] as usize];
         let w = |s: usize| self.weight_of(nb, members[s] as usize);
@@ -236,7 +235,7 @@ impl DensityConstraint {
                 (0, _) => self.first_density(i, pi, x, nb, scratch),
                 (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
-                (_, false) => self.first_step_density(out, scratch),
+                (_, false) => self.first_step_density(first_lambda, out.self_correction, scratch),
             };
             if step == 0 {
                 out.density = rho;
@@ -247,7 +246,7 @@ impl DensityConstraint {
                 dp[0] = out.self_correction;
                 let m = &scratch.members;
                 for (s, w) in m.weights[..m.n].iter().enumerate() {
-                    dp[s + 1] = m.gradient(s) * (out.lambda * w);
+                    dp[s + 1] = m.gradient(s) * (first_lambda * w);
                 }
                 materialized = true;
             }
@@ -278,9 +277,10 @@ impl DensityConstraint {
                 }
                 dp[0] = out.self_correction;
             } else {
-                out.lambda = lambda;
+                first_lambda = lambda;
             }
         }
         out.materialized = materialized;
+        first_lambda
     }
 }

@@ -22,7 +22,7 @@
 use super::search::Prediction;
 use crate::Vec3;
 use crate::boundary::Boundary;
-use crate::constraint::{DensityConstraint, Projection};
+use crate::constraint::{Corrections, DensityConstraint, Projection};
 use crate::neighbors::NeighborLists;
 use crate::reserve::reserve_total;
 use crate::solver::Chebyshev;
@@ -94,6 +94,8 @@ pub(super) struct Iterate<'a> {
     /// X^(k) (m).
     pub x: &'a [Vec3],
     pub projections: &'a [Projection],
+    /// The projections' first λ.
+    pub corrections: &'a Corrections,
     /// Projection weights w_j.
     pub weights: &'a [f64],
     /// Chebyshev's recurrence and weight ω, when the step's extrapolation changes the iterate.
@@ -324,7 +326,7 @@ impl Iterate<'_> {
     fn multiplier(&self, j: usize, all: &Vec3) -> f64 {
         let p = &self.projections[j];
         if !p.materialized {
-            return p.lambda;
+            return self.corrections.lambda(j);
         }
         // Several projection steps: the multiplier that gives the whole correction of the
         // centre along the gradient at x.

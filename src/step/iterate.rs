@@ -135,6 +135,7 @@ pub(super) fn iterate(
                 fluid_lists: &b.fluid_lists,
                 x: &b.current,
                 projections: &b.projections,
+                corrections: &b.corrections,
                 weights: &b.weights,
                 chebyshev: extrapolation,
             });

@@ -49,9 +49,10 @@ impl PointsByComponent {
         self.clear();
         self.try_reserve(total)?;
         for range in ranges {
-            for p in &points[range.clone()] {
-                self.push(*p);
-            }
+            let points = &points[range.clone()];
+            self.x.extend(points.iter().map(|p| p.x));
+            self.y.extend(points.iter().map(|p| p.y));
+            self.z.extend(points.iter().map(|p| p.z));
         }
         Ok(())
     }

@@ -83,6 +83,9 @@ impl DensityConstraint {
         let walls = nb.boundary.of(i);
         let bm = &mut scratch.boundary;
         bm.resize(walls.len());
+        // One index check per member: the components and masses are slices of one length.
+        let (bx, by, bz) = nb.boundary_positions.components();
+        let bpsi = &nb.boundary_psi[..bx.len()];
         for ((((&b, rx), ry), rz), psi) in walls
             .iter()
             .zip(&mut bm.rx)
@@ -90,9 +93,9 @@ impl DensityConstraint {
             .zip(&mut bm.rz)
             .zip(&mut bm.psi)
         {
-            let xb = nb.boundary_positions.at(b as usize);
-            (*rx, *ry, *rz) = (xi.x - xb.x, xi.y - xb.y, xi.z - xb.z);
-            *psi = nb.boundary_psi[b as usize];
+            let b = b as usize;
+            (*rx, *ry, *rz) = (xi.x - bx[b], xi.y - by[b], xi.z - bz[b]);
+            *psi = bpsi[b];
         }
         for (((((len, w), rx), ry), rz), psi) in bm.len[..padded(bm.n)]
             .iter_mut()

@@ -70,6 +70,14 @@ impl PointsByComponent {
         Vec3::new(self.x[i], self.y[i], self.z[i])
     }
 
+    /// The x, y and z components of the points (m), three slices of one length: indexing
+    /// all three at a point checks its index once.
+    #[inline]
+    pub fn components(&self) -> (&[f64], &[f64], &[f64]) {
+        let n = self.x.len();
+        (&self.x, &self.y[..n], &self.z[..n])
+    }
+
     /// The points in order (m).
     pub fn iter(&self) -> impl ExactSizeIterator<Item = Vec3> + '_ {
         (0..self.len()).map(|i| self.at(i))

@@ -250,7 +250,7 @@ typedef struct PfParams {
      * Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
      * 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
      * most η and the last outer iteration moved no particle farther than
-     * 10·`displacement_tolerance`. Default 2.5e-4.
+     * 10·`displacement_tolerance`. Default 3e-4.
      */
     double density_tolerance;
     /**
@@ -263,11 +263,13 @@ typedef struct PfParams {
      */
     uint32_t min_outer_iterations;
     /**
-     * Largest number of outer iterations per step (≤ 100000). Default 100.
+     * Largest number of outer iterations per step (≤ 100000). Default 100. Where Chebyshev's
+     * extrapolation reaches it, the step starts over without extrapolation for at most as
+     * many again (unless it equals `min_outer_iterations`).
      */
     uint32_t max_outer_iterations;
     /**
-     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.75.
+     * CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.25.
      */
     double cfl_factor;
     /**
@@ -310,7 +312,9 @@ typedef struct PfStepStats {
      */
     double dt;
     /**
-     * Outer (local/global) iterations of the last step.
+     * Outer (local/global) iterations of the last step; up to twice `max_outer_iterations`
+     * where Chebyshev's extrapolation reached the limit and the step started over without
+     * it.
      */
     size_t outer_iterations;
     /**
@@ -318,7 +322,8 @@ typedef struct PfStepStats {
      */
     size_t inner_iterations;
     /**
-     * The last step stopped at `max_outer_iterations` instead of the displacement rule.
+     * The last step stopped at `max_outer_iterations` instead of a stopping rule (for
+     * Chebyshev: in the pass without extrapolation that followed).
      */
     bool hit_max_iterations;
     /**

@@ -18,14 +18,16 @@ pub struct StepTimings {
 pub struct StepStats {
     /// Step size (s).
     pub dt: f64,
-    /// Outer (local/global) iterations.
+    /// Outer (local/global) iterations, of both passes where the extrapolation fell back
+    /// (docs/method.md §4), so up to twice the iteration limit.
     pub outer_iterations: usize,
     /// Inner iterations of the linear solver, summed over the outer iterations.
     pub inner_iterations: usize,
-    /// The outer loop ended at its iteration limit instead of the displacement rule.
+    /// The outer loop ended at its iteration limit instead of a stopping rule (in its
+    /// fallback pass, for Chebyshev).
     pub hit_max_iterations: bool,
     /// Chebyshev's ρ_c in this step (the online estimate with `auto_rho`); 0 for the other
-    /// solvers.
+    /// solvers, and where the step fell back to the plain iteration.
     pub rho: f64,
     /// Largest particle displacement in the last outer iteration (m).
     pub last_displacement: f64,

@@ -98,7 +98,7 @@ def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World)
     assert defaults.solver == projfluid.Solver.CHEBYSHEV
     assert defaults.gravity == (0.0, -9.81, 0.0)
     assert defaults.chebyshev_auto_rho is False and defaults.chebyshev_rho == 0.99
-    assert defaults.density_tolerance == 2.5e-4 and defaults.cfl_factor == 0.75
+    assert defaults.density_tolerance == 3e-4 and defaults.cfl_factor == 1.25
     p = projfluid.Params(solver="cg", projection_weight=1, threads=np.int64(3))
     assert p.solver is projfluid.Solver.CG
     assert p.projection_weight is projfluid.ProjectionWeight.UNIT

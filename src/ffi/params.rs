@@ -90,16 +90,18 @@ pub struct PfParams {
     /// Outer stopping threshold η on the average density error (dimensionless, in [0, 1);
     /// 0 turns the rule off): stop when the mean over the fluid of max(ρ_i/ρ0 − 1, 0) is at
     /// most η and the last outer iteration moved no particle farther than
-    /// 10·`displacement_tolerance`. Default 2.5e-4.
+    /// 10·`displacement_tolerance`. Default 3e-4.
     pub density_tolerance: f64,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
     /// outer iteration. Default 3e-3·r.
     pub displacement_tolerance: f64,
     /// Smallest number of outer iterations per step (≥ 1). Default 1.
     pub min_outer_iterations: u32,
-    /// Largest number of outer iterations per step (≤ 100000). Default 100.
+    /// Largest number of outer iterations per step (≤ 100000). Default 100. Where Chebyshev's
+    /// extrapolation reaches it, the step starts over without extrapolation for at most as
+    /// many again (unless it equals `min_outer_iterations`).
     pub max_outer_iterations: u32,
-    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 0.75.
+    /// CFL factor λ in Δt = λ·0.4·2r/v_max. Default 1.25.
     pub cfl_factor: f64,
     /// Smallest CFL step (s). Default 1e-4.
     pub dt_min: f64,

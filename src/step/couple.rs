@@ -215,6 +215,14 @@ impl Coupling {
         }
     }
 
+    /// Forgets the outer iterations followed so far, for an iteration that starts over from
+    /// the prediction (the shares at X^(0) = X^(−1) = s are zero).
+    pub(super) fn restart(&mut self) {
+        for u in [&mut self.previous, &mut self.current, &mut self.next] {
+            u.fill(Vec3::zeros());
+        }
+    }
+
     /// Follows one outer iteration: the shares at X^(k+1) from those at X^(k) and X^(k−1)
     /// and the boundary's corrections at X^(k).
     pub(super) fn update(&mut self, it: &Iterate) {

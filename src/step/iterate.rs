@@ -2,7 +2,7 @@
 //! matrix of formulation F1 frozen for the step, then local projections and global solves
 //! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until the fluid's average
 //! compression is at most η (once no particle moves farther than 10τ) or no particle moved
-//! farther than τ.
+//! farther than τ; a step whose extrapolation reaches K_max starts over without it.
 
 use super::search::Prediction;
 use super::{StepBuffers, couple};
@@ -99,21 +99,42 @@ pub(super) fn iterate(
         weights: &b.weights,
     };
     chebyshev.reset();
-    let accelerate = params.solver == SolverKind::Chebyshev;
+    let mut accelerate = params.solver == SolverKind::Chebyshev;
     let single_sweep = solver.single_diagonal_sweep();
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
     let (mut converged, mut densities_known) = (false, false);
+    // The outer iterations of the current pass (the second, if any, is the fallback).
+    let mut k = 0;
     b.displacements.clear();
     if couple {
         let (lists, diagonal) = (&b.fluid_lists, &b.system.diagonal);
         b.coupling
             .prepare(constraint, lists, &b.weights, diagonal, dt2k);
     }
-    while outer < params.max_outer_iterations {
+    loop {
+        if k == params.max_outer_iterations {
+            // A fixed count (K_min = K_max, as ρ sweeps ask for) ends here too.
+            if !accelerate || params.min_outer_iterations >= params.max_outer_iterations {
+                break;
+            }
+            // The extrapolation reached K_max without a rule holding: the step starts over
+            // from s without it, for at most K_max more (docs/method.md §4, "Fallback").
+            let predicted = Prediction::new(fluid, Some(&b.order), dt, gravity);
+            b.current
+                .par_iter_mut()
+                .enumerate()
+                .for_each(|(j, x)| *x = predicted.at(j));
+            b.previous.clone_from(&b.current);
+            if couple {
+                b.coupling.restart();
+            }
+            (accelerate, k, displacement) = (false, 0, f64::INFINITY);
+            b.displacements.clear();
+        }
         let t = Instant::now();
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections)?;
         let t_local = t.elapsed().as_secs_f64();
-        if outer >= params.min_outer_iterations
+        if k >= params.min_outer_iterations
             && displacement < DENSITY_RULE_MOTION * params.displacement_tolerance
             && average_compression(constraint, &b.projections) <= params.density_tolerance
         {
@@ -123,7 +144,7 @@ pub(super) fn iterate(
             break;
         }
         let omega = if accelerate {
-            chebyshev.next_weight(outer)
+            chebyshev.next_weight(k)
         } else {
             1.0
         };
@@ -196,9 +217,10 @@ pub(super) fn iterate(
             std::mem::swap(&mut b.current, &mut b.next);
         }
         outer += 1;
+        k += 1;
         timings.local += t_local;
         timings.global += t.elapsed().as_secs_f64() - t_local;
-        if outer >= params.min_outer_iterations && displacement < params.displacement_tolerance {
+        if k >= params.min_outer_iterations && displacement < params.displacement_tolerance {
             converged = true;
             break;
         }

@@ -18,11 +18,14 @@ pub struct PfStepStats {
     pub time: f64,
     /// Size of the last step (s).
     pub dt: f64,
-    /// Outer (local/global) iterations of the last step.
+    /// Outer (local/global) iterations of the last step; up to twice `max_outer_iterations`
+    /// where Chebyshev's extrapolation reached the limit and the step started over without
+    /// it.
     pub outer_iterations: usize,
     /// Inner linear-solver iterations of the last step, summed over its outer iterations.
     pub inner_iterations: usize,
-    /// The last step stopped at `max_outer_iterations` instead of the displacement rule.
+    /// The last step stopped at `max_outer_iterations` instead of a stopping rule (for
+    /// Chebyshev: in the pass without extrapolation that followed).
     pub hit_max_iterations: bool,
     /// Largest particle displacement (m) in the last outer iteration of the last step.
     pub last_displacement: f64,

@@ -13,8 +13,8 @@ pub(crate) struct ParamOptions {
     /// Chebyshev spectral radius estimate ρ_c, in [0, 1), or `auto` to estimate it online.
     #[arg(long, value_name = "R|auto", allow_negative_numbers = true, value_parser = rho_parser)]
     pub(crate) rho: Option<RhoArg>,
-    /// Outer stopping threshold η on the average density error, a fraction (2.5e-4 =
-    /// 0.025 %; 0 turns the density rule off).
+    /// Outer stopping threshold η on the average density error, a fraction (3e-4 =
+    /// 0.03 %; 0 turns the density rule off).
     #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
     pub(crate) eta: Option<f64>,
     /// Outer stopping threshold τ, in metres (stop when no particle moves farther).

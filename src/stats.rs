@@ -27,7 +27,8 @@ pub struct StepStats {
     /// fallback pass, for Chebyshev).
     pub hit_max_iterations: bool,
     /// Chebyshev's ρ_c in this step (the online estimate with `auto_rho`); 0 for the other
-    /// solvers, and where the step fell back to the plain iteration.
+    /// solvers. A step that fell back to the plain iteration reports the ρ_c its first pass
+    /// extrapolated with.
     pub rho: f64,
     /// Largest particle displacement in the last outer iteration (m).
     pub last_displacement: f64,

@@ -595,7 +595,7 @@ fn rho_auto_runs_and_reports_its_estimate() {
     // The options reach the world that runs.
     assert_eq!(json["threads"], 1);
     let rho = json["rho"].as_f64().unwrap();
-    // The mean over the steps: the starting value 0.95 until the first estimate, then
+    // The mean over the steps: the starting value 0.99 until the first estimate, then
     // estimates within [0.5, 0.925].
     assert!((0.5..0.95).contains(&rho), "mean rho {rho}");
 }

@@ -100,6 +100,8 @@ pub(super) fn iterate(
     };
     chebyshev.reset();
     let mut accelerate = params.solver == SolverKind::Chebyshev;
+    // The ρ_c the step extrapolates with (reported also where it falls back).
+    let rho = if accelerate { chebyshev.rho() } else { 0.0 };
     let single_sweep = solver.single_diagonal_sweep();
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
     let (mut converged, mut densities_known) = (false, false);
@@ -128,6 +130,8 @@ pub(super) fn iterate(
             if couple {
                 b.coupling.restart();
             }
+            // The online estimate learns from the extrapolated pass before it is dropped.
+            chebyshev.finish_step(&b.displacements);
             (accelerate, k, displacement) = (false, 0, f64::INFINITY);
             b.displacements.clear();
         }
@@ -226,7 +230,6 @@ pub(super) fn iterate(
         }
     }
 
-    let rho = if accelerate { chebyshev.rho() } else { 0.0 };
     if accelerate {
         chebyshev.finish_step(&b.displacements);
     }

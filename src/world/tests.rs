@@ -639,7 +639,6 @@ fn a_step_whose_extrapolation_reaches_the_limit_starts_over_without_it() {
         first.outer_iterations > limit && first.outer_iterations <= 2 * limit,
         "{first:?}"
     );
-    assert_eq!(first.rho, 0.0, "the first step fell back: {first:?}");
     while world.time() < 0.1 {
         let stats = world.step().unwrap();
         assert!(stats.outer_iterations <= 2 * limit);

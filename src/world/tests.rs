@@ -662,3 +662,60 @@ fn a_step_whose_extrapolation_reaches_the_limit_starts_over_without_it() {
         );
     }
 }
+
+/// The fallback pass is the plain iteration from s: a Chebyshev step that falls back ends
+/// where the `jacobi1` solver ends the same step, bit for bit, in the particles and in the
+/// load on a dynamic box beside the water (whose share of the iteration starts over too).
+#[test]
+fn a_step_that_falls_back_ends_where_the_plain_iteration_ends() {
+    use crate::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
+    use crate::params::SolverKind;
+    let first_step = |solver: SolverKind| {
+        let params = Params {
+            particle_radius: 0.02,
+            displacement_tolerance: 2e-5,
+            solver,
+            ..Params::default()
+        };
+        let mut world = World::new(params).unwrap();
+        let container = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::new(0.5, 0.4, 0.3),
+        };
+        world.add_container(container, 1).unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::zeros())
+            .unwrap();
+        let half = Vec3::repeat(0.05);
+        world
+            .add_body(BodySpec {
+                kind: BodyKind::Dynamic,
+                mesh: Shape::Box { half_extents: half }.mesh(0.02).unwrap(),
+                mass: Some(BodyMass::Density(500.0)),
+                pose: Pose {
+                    position: Vec3::new(0.31, 0.1, 0.15),
+                    rotation: Rotation::identity(),
+                },
+                velocity: Velocity::default(),
+                motion: None,
+            })
+            .unwrap();
+        let stats = world.step().unwrap().clone();
+        let (force, torque) = {
+            let body = world.body(0).unwrap();
+            (body.force, body.torque)
+        };
+        (stats, world.positions(), force, torque)
+    };
+    let (accelerated, x, force, torque) = first_step(SolverKind::Chebyshev);
+    let (plain, x_plain, force_plain, torque_plain) = first_step(SolverKind::Jacobi1);
+    let limit = Params::default().max_outer_iterations;
+    assert_eq!(
+        accelerated.outer_iterations,
+        limit + plain.outer_iterations,
+        "{accelerated:?} against {plain:?}"
+    );
+    assert!(force.norm() > 0.0, "the box feels the water");
+    assert!(x == x_plain);
+    assert_eq!((force, torque), (force_plain, torque_plain));
+}

@@ -9,6 +9,15 @@ pub(crate) fn reserve_total<T>(v: &mut Vec<T>, total: usize) -> Result<(), TryRe
     v.try_reserve(total.saturating_sub(v.len()))
 }
 
+/// Makes `out` a copy of `from`, reusing its storage; errors when memory for it cannot be
+/// had (`out` is then empty).
+pub(crate) fn copy_reusing<T: Copy>(out: &mut Vec<T>, from: &[T]) -> Result<(), TryReserveError> {
+    out.clear();
+    reserve_total(out, from.len())?;
+    out.extend_from_slice(from);
+    Ok(())
+}
+
 /// The error that reports a shortage found by a library that does not say more (a failed
 /// allocation inside a factorisation): the one of a request no allocator could grant.
 pub(crate) fn shortage() -> TryReserveError {

@@ -8,6 +8,7 @@
 use super::Boundary;
 use crate::neighbors::{CellTable, PointsByComponent};
 use crate::permutation::unpermute_in_place;
+use crate::reserve::copy_reusing;
 use std::collections::TryReserveError;
 
 /// What a [`BoundaryCopy`] holds.
@@ -97,7 +98,7 @@ impl Boundary {
             return Ok(());
         }
         copy.positions.try_copy_from(&self.positions)?;
-        copy_into(&mut copy.owner, &self.owner)?;
+        copy_reusing(&mut copy.owner, &self.owner)?;
         if copy.held == Held::Order {
             let (positions, owner) = (&mut copy.positions, &mut copy.owner);
             unpermute_in_place(&mut copy.order, |a, b| {
@@ -106,7 +107,7 @@ impl Boundary {
             });
             copy.order = Vec::new();
         } else {
-            copy_into(&mut copy.psi, &self.psi)?;
+            copy_reusing(&mut copy.psi, &self.psi)?;
             copy.table.try_copy_from(&self.table)?;
             copy.dirty = self.dirty;
         }
@@ -139,14 +140,6 @@ impl Boundary {
             copy.release();
         }
     }
-}
-
-/// Makes `out` a copy of `from`, reusing its storage.
-fn copy_into<T: Copy>(out: &mut Vec<T>, from: &[T]) -> Result<(), TryReserveError> {
-    out.clear();
-    crate::reserve::reserve_total(out, from.len())?;
-    out.extend_from_slice(from);
-    Ok(())
 }
 
 #[cfg(test)]

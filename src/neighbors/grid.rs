@@ -3,7 +3,7 @@
 
 use super::PointsByComponent;
 use crate::Vec3;
-use crate::reserve::reserve_total;
+use crate::reserve::{copy_reusing, reserve_total};
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
@@ -234,10 +234,7 @@ impl CellTable {
     /// Makes this table a copy of `other`'s cell ranges (not of its scratch), reusing this
     /// one's storage; errors when memory for them cannot be had (the table is then empty).
     pub(crate) fn try_copy_from(&mut self, other: &CellTable) -> Result<(), TryReserveError> {
-        self.cell_start.clear();
-        reserve_total(&mut self.cell_start, other.cell_start.len())?;
-        self.cell_start.extend_from_slice(&other.cell_start);
-        Ok(())
+        copy_reusing(&mut self.cell_start, &other.cell_start)
     }
 }
 

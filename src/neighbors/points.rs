@@ -2,7 +2,7 @@
 //! among, and in which the boundary keeps its particles.
 
 use crate::Vec3;
-use crate::reserve::reserve_total;
+use crate::reserve::{copy_reusing, reserve_total};
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
@@ -160,16 +160,9 @@ impl PointsByComponent {
         &mut self,
         other: &PointsByComponent,
     ) -> Result<(), TryReserveError> {
-        for (out, from) in [
-            (&mut self.x, &other.x),
-            (&mut self.y, &other.y),
-            (&mut self.z, &other.z),
-        ] {
-            out.clear();
-            reserve_total(out, from.len())?;
-            out.extend_from_slice(from);
-        }
-        Ok(())
+        copy_reusing(&mut self.x, &other.x)?;
+        copy_reusing(&mut self.y, &other.y)?;
+        copy_reusing(&mut self.z, &other.z)
     }
 
     /// Reserves room for `points` points in all (as [`Vec::try_reserve`], with room to grow).

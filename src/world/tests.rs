@@ -613,32 +613,41 @@ fn lattice_block_interior_is_at_rest_density_after_the_first_step() {
     }
 }
 
+/// The box of [`corner_start`].
+const CORNER_BOX: Aabb = Aabb {
+    min: Vec3::new(0.0, 0.0, 0.0),
+    max: Vec3::new(0.5, 0.4, 0.3),
+};
+
+/// A 6 × 7 × 5 block of water 1.5r from three walls of [`CORNER_BOX`] (r = 0.02 m, τ = 2e-5
+/// m), with `params` for the rest: closer to the walls than docs/method.md §7 asks, so that
+/// it starts up to 50 % compressed in the corners and its first steps hit K_max.
+fn corner_start(params: Params) -> World {
+    let params = Params {
+        particle_radius: 0.02,
+        displacement_tolerance: 2e-5,
+        ..params
+    };
+    let mut world = World::new(params).unwrap();
+    world.add_container(CORNER_BOX, 1).unwrap();
+    world
+        .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::zeros())
+        .unwrap();
+    world
+}
+
 /// Water placed 1.5r from three walls starts up to 50 % compressed in the corners, and the
 /// first steps hit K_max. There Chebyshev's extrapolation at the default ρ_c = 0.99 threw
 /// corner particles through the walls within the first steps; the step that reaches K_max
 /// starts over without the extrapolation (docs/method.md §4, "Fallback"), which keeps them in.
 #[test]
 fn a_step_whose_extrapolation_reaches_the_limit_starts_over_without_it() {
-    let start = |threads: usize| {
-        let params = Params {
-            particle_radius: 0.02,
-            displacement_tolerance: 2e-5,
+    let start = |threads| {
+        corner_start(Params {
             threads,
             ..Params::default()
-        };
-        let mut world = World::new(params).unwrap();
-        world.add_container(container(), 1).unwrap();
-        world
-            .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::zeros())
-            .unwrap();
-        world
+        })
     };
-    fn container() -> Aabb {
-        Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::new(0.5, 0.4, 0.3),
-        }
-    }
     let (mut world, mut other) = (start(1), start(2));
     let limit = world.params().max_outer_iterations;
     let first = world.step().unwrap();
@@ -656,7 +665,7 @@ fn a_step_whose_extrapolation_reaches_the_limit_starts_over_without_it() {
             world
                 .positions()
                 .iter()
-                .all(|p| container().contains(p, 0.0)),
+                .all(|p| CORNER_BOX.contains(p, 0.0)),
             "t = {} s: a particle left the box",
             world.time()
         );
@@ -671,21 +680,10 @@ fn a_step_that_falls_back_ends_where_the_plain_iteration_ends() {
     use crate::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
     use crate::params::SolverKind;
     let first_step = |solver: SolverKind| {
-        let params = Params {
-            particle_radius: 0.02,
-            displacement_tolerance: 2e-5,
+        let mut world = corner_start(Params {
             solver,
             ..Params::default()
-        };
-        let mut world = World::new(params).unwrap();
-        let container = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::new(0.5, 0.4, 0.3),
-        };
-        world.add_container(container, 1).unwrap();
-        world
-            .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::zeros())
-            .unwrap();
+        });
         let half = Vec3::repeat(0.05);
         world
             .add_body(BodySpec {

@@ -30,7 +30,7 @@ mod point;
 #[cfg(test)]
 mod tests;
 
-pub use gauge::Gauge;
+pub use gauge::{Gauge, GaugeMeasure};
 pub use point::PressureProbe;
 
 use crate::boundary::Aabb;
@@ -60,7 +60,8 @@ pub struct ProbeSet {
 pub struct ProbeReading {
     /// Simulated time of the reading (s).
     pub time: f64,
-    /// Each gauge's free-surface height above its bottom (m), in the order of the gauges.
+    /// Each gauge's reading above its bottom (m), by its [`GaugeMeasure`], in the order of
+    /// the gauges.
     pub heights: Vec<f64>,
     /// Each pressure probe's pressure (Pa; NaN with no fluid within the kernel support), in
     /// the order of the probes.
@@ -183,7 +184,7 @@ impl ProbeSet {
             let mut lists = (NeighborLists::default(), NeighborLists::default());
             let heights = lines
                 .iter()
-                .map(|line| line.surface_height(world, &snapshot, &mut lists))
+                .map(|line| line.reading(world, &snapshot, &mut lists))
                 .collect();
             let pressures = if self.pressure.is_empty() {
                 Vec::new()

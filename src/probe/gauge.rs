@@ -1,5 +1,7 @@
 //! Water-height gauges: the free surface of the water column on a vertical line, where the SPH
-//! fluid fraction first falls below ½ going up from the gauge's bottom (docs/method.md §10.3).
+//! fluid fraction first falls below ½ going up from the gauge's bottom, or the water content
+//! of the line, the depth all the water on it would have if it stood on the bottom
+//! (docs/method.md §10.3).
 
 use crate::boundary::Aabb;
 use crate::neighbors::NeighborLists;
@@ -14,7 +16,8 @@ use serde::{Deserialize, Serialize};
 /// fraction φ (the SPH sum of the particles' volumes, walls included, docs/method.md §10.3)
 /// falls below ½. Water above that height — spray, droplets, a sheet over an air pocket — is
 /// not counted. A bottom that is dry (φ < ½ there) reads 0; a column that reaches `top`
-/// reads `top − bottom`.
+/// reads `top − bottom`. With [`GaugeMeasure::Content`] it reads instead all the water on
+/// the line above `bottom`, standing or not.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Gauge {
@@ -32,6 +35,38 @@ pub struct Gauge {
     /// until the fluid fraction falls below ½.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub top: Option<f64>,
+    /// What the gauge reads (m): the surface of the standing column (the default), or the
+    /// line's water content.
+    #[serde(default, skip_serializing_if = "GaugeMeasure::is_surface")]
+    pub measure: GaugeMeasure,
+}
+
+/// What a [`Gauge`] reads, in metres above its bottom.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum GaugeMeasure {
+    /// The free surface of the water column standing on the bottom: the height at which the
+    /// fluid fraction, going up the line, first falls below ½. What a gauge that sees the
+    /// water's surface (an acoustic or optical one) reads.
+    #[default]
+    Surface,
+    /// The water content of the line: Σ_j (m/ρ0)·W̄(d_j) over the fluid particles j above the
+    /// bottom (and below the top), d_j their horizontal distance from the line and W̄ the
+    /// kernel summed along the line ([`CubicKernel::line_integral`]). It is the depth the water
+    /// on the line would have if it stood on the bottom: the surface height for a column
+    /// standing there, and more than 0 for water falling or flying over a dry bottom. Closer
+    /// to what a wire gauge reads, whose signal follows its wetted length wherever the water
+    /// touches it.
+    ///
+    /// [`CubicKernel::line_integral`]: crate::kernel::CubicKernel::line_integral
+    Content,
+}
+
+impl GaugeMeasure {
+    /// Whether this is the default, [`GaugeMeasure::Surface`].
+    fn is_surface(&self) -> bool {
+        *self == Self::Surface
+    }
 }
 
 impl Gauge {
@@ -44,6 +79,7 @@ impl Gauge {
             z,
             bottom: None,
             top: None,
+            measure: GaugeMeasure::Surface,
         }
     }
 
@@ -93,6 +129,7 @@ impl Gauge {
             z: self.z,
             bottom: self.bottom_in(containers)?,
             top: self.top,
+            measure: self.measure,
         })
     }
 }
@@ -113,12 +150,41 @@ pub(super) struct Line {
     z: f64,
     bottom: f64,
     top: Option<f64>,
+    measure: GaugeMeasure,
 }
 
 impl Line {
-    /// The gauge's reading (m) in `snapshot` of `world`: see [`Gauge`]. `lists` are scratch
-    /// for the neighbour searches (fluid, boundary). Runs on the caller's thread pool.
-    pub(super) fn surface_height(
+    /// The gauge's reading (m) in `snapshot` of `world`, by its [`GaugeMeasure`]. `lists` are
+    /// scratch for the neighbour searches (fluid, boundary). Runs on the caller's thread pool.
+    pub(super) fn reading(
+        &self,
+        world: &World,
+        snapshot: &Snapshot,
+        lists: &mut (NeighborLists, NeighborLists),
+    ) -> f64 {
+        match self.measure {
+            GaugeMeasure::Surface => self.surface_height(world, snapshot, lists),
+            GaugeMeasure::Content => self.water_content(world, snapshot),
+        }
+    }
+
+    /// The line's water content (m), [`GaugeMeasure::Content`]: summed in the snapshot's
+    /// order, so the same for any thread count.
+    fn water_content(&self, world: &World, snapshot: &Snapshot) -> f64 {
+        let c = &world.constraint;
+        let volume = c.mass / c.rest_density;
+        let top = self.top.unwrap_or(f64::INFINITY);
+        snapshot
+            .fluid
+            .iter()
+            .filter(|p| p.y >= self.bottom && p.y <= top)
+            .map(|p| c.kernel.line_integral((p.x - self.x).hypot(p.z - self.z)))
+            .sum::<f64>()
+            * volume
+    }
+
+    /// The height of the standing column's surface (m), [`GaugeMeasure::Surface`].
+    fn surface_height(
         &self,
         world: &World,
         snapshot: &Snapshot,

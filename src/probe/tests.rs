@@ -25,6 +25,16 @@ struct Settled {
     reading: ProbeReading,
     /// The gauges' reading with spray particles added above the water.
     with_spray: Vec<f64>,
+    /// N·V/area (m): the depth the water would have at rest density, spread evenly.
+    volume_depth: f64,
+    /// Water-content gauges on the same lines: their gauges, and their readings before and
+    /// after the spray was added.
+    content: (Vec<Gauge>, Vec<f64>, Vec<f64>),
+    /// The spray particles' positions (m).
+    spray: Vec<Vec3>,
+    /// The volume m/ρ0 of a particle (m³) and the kernel.
+    particle_volume: f64,
+    kernel: crate::kernel::CubicKernel,
 }
 
 /// An 8 × 10 × 8 lattice (r = 2.5 cm, mass factor 1, the calm settings) in a closed tank with
@@ -79,6 +89,18 @@ fn settled_tank() -> &'static Settled {
         world.set_displacement_tolerance(1e-5 * r).unwrap();
         world.advance(0.25).unwrap();
         let reading = probes.read(&world).unwrap();
+        let content = ProbeSet {
+            rate: 100.0,
+            gauges: (probes.gauges.iter())
+                .map(|g| Gauge {
+                    name: format!("{}_content", g.name),
+                    measure: GaugeMeasure::Content,
+                    ..g.clone()
+                })
+                .collect(),
+            pressure: Vec::new(),
+        };
+        let content_before = content.read(&world).unwrap().heights;
 
         let positions = world.positions();
         let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
@@ -103,6 +125,7 @@ fn settled_tank() -> &'static Settled {
         }
         world.add_fluid_particles(&spray, None).unwrap();
         let with_spray = probes.read(&world).unwrap().heights;
+        let content_after = content.read(&world).unwrap().heights;
         Settled {
             spacing: d,
             volume_surface: volume / area + 0.5 * d,
@@ -110,6 +133,11 @@ fn settled_tank() -> &'static Settled {
             probes,
             reading,
             with_spray,
+            volume_depth: volume / area,
+            content: (content.gauges, content_before, content_after),
+            spray,
+            particle_volume: world.particle_mass() / RHO0,
+            kernel: crate::kernel::CubicKernel::new(world.params().support_radius()),
         }
     })
 }
@@ -135,6 +163,55 @@ fn gauges_read_the_water_height_and_ignore_spray() {
     }
     for (a, b) in t.reading.heights.iter().zip(&t.with_spray) {
         assert!((a - b).abs() <= 1e-9, "spray moved a gauge from {a} to {b}");
+    }
+}
+
+/// A water-content gauge reads the depth of the settled water within a quarter spacing, as the
+/// particles show it (top layer + d/2, less the d/2 between the floor's particle plane and
+/// the water) and as the surface gauges read it; within half a spacing of what the volume
+/// N·V/area says (the settled water stands 2–3 % higher than that); spray above the water adds to it exactly what its particles' volumes
+/// put on the line, though the surface gauges do not see it.
+#[test]
+fn content_gauges_count_all_the_water_on_the_line() {
+    let t = settled_tank();
+    let (gauges, before, after) = &t.content;
+    for ((gauge, content), (g, surface)) in gauges
+        .iter()
+        .zip(before)
+        .zip(t.probes.gauges.iter().zip(&t.reading.heights))
+    {
+        let depth = t.particle_surface - 0.5 * t.spacing;
+        assert!(
+            (content - depth).abs() <= 0.25 * t.spacing,
+            "{}: {content:.4} m, top layer = {depth:.4} m",
+            gauge.name
+        );
+        assert!(
+            (content - t.volume_depth).abs() <= 0.5 * t.spacing,
+            "{}: {content:.4} m, N·V/area = {:.4} m",
+            gauge.name,
+            t.volume_depth
+        );
+        // The standing column's surface lies d/2 above the content's depth (its bottom face
+        // is d/2 above the floor's particle plane).
+        assert!(
+            (surface - content - 0.5 * t.spacing).abs() <= 0.25 * t.spacing,
+            "{}: surface {surface:.4} m, content {content:.4} m",
+            g.name
+        );
+    }
+    for ((gauge, a), b) in gauges.iter().zip(before).zip(after) {
+        let spray: f64 = (t.spray.iter())
+            .map(|p| t.kernel.line_integral((p.x - gauge.x).hypot(p.z - gauge.z)))
+            .sum::<f64>()
+            * t.particle_volume;
+        assert!(spray > 0.5 * t.spacing, "{}: spray {spray}", gauge.name);
+        assert!(
+            (b - a - spray).abs() <= 1e-9,
+            "{}: the spray added {} m, its volume on the line is {spray} m",
+            gauge.name,
+            b - a
+        );
     }
 }
 
@@ -371,15 +448,17 @@ fn scene_key_probes_reads_and_round_trips() {
         )
     };
     let probes = r#"{"rate": 200,
-        "gauges": [{"name": "H1", "x": 0.2, "z": 0.2}, {"name": "H2", "x": 0.3, "z": 0.1, "bottom": 0.05, "top": 0.4}],
+        "gauges": [{"name": "H1", "x": 0.2, "z": 0.2}, {"name": "H2", "x": 0.3, "z": 0.1, "bottom": 0.05, "top": 0.4}, {"name": "C", "x": 0.25, "z": 0.2, "measure": "content"}],
         "pressure": [{"name": "P1", "position": [0.2, 0.05, 0.2]}, {"name": "W1", "position": [0, 0.1, 0.2], "wall": true}]}"#;
     let scene = Scene::from_json(&scene_text(probes)).unwrap();
     let set = scene.probes.clone().unwrap();
     assert_eq!(set.rate, 200.0);
     assert_eq!(set.gauges[1].bottom, Some(0.05));
     assert_eq!(set.gauges[0].top, None);
+    assert_eq!(set.gauges[0].measure, GaugeMeasure::Surface);
+    assert_eq!(set.gauges[2].measure, GaugeMeasure::Content);
     assert!(set.pressure[1].wall && !set.pressure[0].wall);
-    assert_eq!(set.columns(), ["H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(set.columns(), ["H1_m", "H2_m", "C_m", "P1_Pa", "W1_Pa"]);
     assert_eq!(crate::scene::probes_from_json(probes).unwrap(), set);
     let json = scene.to_json();
     assert_eq!(Scene::from_json(&json).unwrap(), scene, "{json}");
@@ -395,6 +474,13 @@ fn scene_key_probes_reads_and_round_trips() {
     ));
     assert!(
         unknown.contains("probes.gauges[0]: unknown field `y`"),
+        "{unknown}"
+    );
+    let unknown = message(&scene_text(
+        r#"{"rate": 20, "gauges": [{"name": "H", "x": 0.2, "z": 0.2, "measure": "depth"}]}"#,
+    ));
+    assert!(
+        unknown.contains("unknown variant `depth`, expected `surface` or `content`"),
         "{unknown}"
     );
     let unknown = crate::scene::probes_from_json(r#"{"rate": 20, "gauge": []}"#)
@@ -429,7 +515,8 @@ fn documented_probes_example_is_valid() {
     );
     let scene = Scene::from_json(&text).unwrap();
     let probes = scene.probes.unwrap();
-    assert_eq!(probes.columns(), ["H1_m", "H2_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(probes.columns(), ["H1_m", "H2_m", "C1_m", "P1_Pa", "W1_Pa"]);
+    assert_eq!(probes.gauges[2].measure, GaugeMeasure::Content);
     assert_eq!(probes.rate, 100.0);
     assert!(probes.pressure[1].wall);
     assert_eq!(probes.pressure[1].position[0], scene.containers[0].max[0]);

@@ -35,6 +35,11 @@ fn dam_break(duration: f64, change: impl FnOnce(&mut Setup)) -> (Run, Comparison
 /// height at H4 lies within the height tolerance at every compared time. No particle escapes
 /// and the compression stays small.
 ///
+/// The water content of the gauges' lines agrees with the surface where water stands (H2, H3,
+/// H4: RMS difference below a fifth of a spacing once the water is 5 cm deep), while in the
+/// box's lee the water first comes through the air: H1's content reaches 5 cm at least 0.1 s
+/// before its standing surface does (docs/validation.md).
+///
 /// The same comparison must fail with gravity scaled by 0.8 (every arrival late, the
 /// reservoir falls too slowly), and without the box (the surge reaches H1, in the box's lee,
 /// about 0.4 s early; 1 s of flow decides it).
@@ -53,6 +58,28 @@ fn dam_break_past_a_box_matches_kleefsman_and_discriminates() {
         "{}\n{:#?}",
         cmp.table(),
         cmp.failures()
+    );
+
+    let first_reaching =
+        |series: Vec<(f64, f64)>, level: f64| series.iter().find(|p| p.1 >= level).map(|p| p.0);
+    for g in 1..4 {
+        let pairs: Vec<(f64, f64)> = (run.heights(g).iter().zip(run.contents(g)))
+            .filter(|(h, _)| h.1 > 0.05)
+            .map(|(h, c)| (h.1, c.1))
+            .collect();
+        assert!(pairs.len() > 100, "gauge {g}: {} wet readings", pairs.len());
+        let rms =
+            (pairs.iter().map(|(h, c)| (c - h).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
+        assert!(
+            rms <= 0.2 * 2.0 * TEST_RADIUS,
+            "gauge {g}: content against surface RMS {rms} m"
+        );
+    }
+    let content = first_reaching(run.contents(LEE_GAUGE), 0.05).expect("water reaches H1");
+    let surface = first_reaching(run.heights(LEE_GAUGE), 0.05).expect("water stands at H1");
+    assert!(
+        content + 0.1 <= surface,
+        "H1: content 5 cm at {content} s, surface at {surface} s"
     );
 
     let (_, weak) = dam_break(2.0, |s| s.gravity *= 0.8);
@@ -134,9 +161,19 @@ fn cli_kleefsman_writes_its_table_csv_and_charts() {
         assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
     }
     let series = std::fs::read_to_string(dir.join("kleefsman_series.csv")).unwrap();
-    assert!(series.starts_with("t_s,H1_m,H2_m,H3_m,H4_m\n"), "{series}");
+    assert!(
+        series.starts_with(
+            "t_s,H1_m,H2_m,H3_m,H4_m,H1_content_m,H2_content_m,H3_content_m,H4_content_m\n"
+        ),
+        "{series}"
+    );
     let csv = std::fs::read_to_string(dir.join("kleefsman_comparison.csv")).unwrap();
     assert!(csv.lines().any(|l| l.starts_with("arrival_s,H1,")), "{csv}");
+    assert!(
+        csv.lines().any(|l| l.starts_with("content_rms_m,H1,")),
+        "{csv}"
+    );
+    assert!(stdout.contains("water on H1's line"), "{stdout}");
 }
 
 #[test]

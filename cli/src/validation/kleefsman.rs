@@ -63,8 +63,12 @@ pub fn world_point([x, y, z]: [f64; 3]) -> [f64; 3] {
 pub struct Sample {
     /// Time since release (s).
     pub time: f64,
-    /// Water height at each gauge of [`GAUGES`] (m).
+    /// Water height at each gauge of [`GAUGES`] (m): the standing water's surface.
     pub heights: [f64; 4],
+    /// Water content of each gauge's line (m): the depth all the water on it would have
+    /// standing on the floor, falling and flying water included
+    /// ([`projfluid::probe::GaugeMeasure::Content`]).
+    pub contents: [f64; 4],
 }
 
 /// A finished run: the setup and the gauge history.
@@ -99,6 +103,14 @@ impl Run {
             .collect()
     }
 
+    /// The water content of gauge `g`'s line as (time (s), content (m)).
+    pub fn contents(&self, g: usize) -> Vec<(f64, f64)> {
+        self.samples
+            .iter()
+            .map(|s| (s.time, s.contents[g]))
+            .collect()
+    }
+
     /// The simulated time covered (s).
     pub fn end(&self) -> f64 {
         self.samples.last().map_or(0.0, |s| s.time)
@@ -113,12 +125,15 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Run, Err
     let mut world = scene.build_world()?;
     let probes = scene.probes.as_ref().expect("the scene has its gauges");
     let read = |world: &projfluid::World| -> Result<Sample, Error> {
+        // The scene's gauges: the four surfaces, then the four contents.
         let reading = probes.read(world)?;
-        let mut heights = [0.0; 4];
-        heights.copy_from_slice(&reading.heights);
+        let (mut heights, mut contents) = ([0.0; 4], [0.0; 4]);
+        heights.copy_from_slice(&reading.heights[..4]);
+        contents.copy_from_slice(&reading.heights[4..]);
         Ok(Sample {
             time: reading.time,
             heights,
+            contents,
         })
     };
     let mut samples = vec![read(&world)?];

@@ -69,10 +69,33 @@ impl Comparison {
                 mark(l.verdict(t.reservoir))
             );
         }
-        let _ = writeln!(out, "\nRMS height difference over the run (m)");
-        for (g, rms) in self.rms.iter().enumerate() {
-            let _ = writeln!(out, "{:>5}  {:>7.3}  {rms:.4}", GAUGES[g], GAUGE_X[g]);
+        let _ = writeln!(
+            out,
+            "\nRMS difference from the measured height over the run (m): the standing water's \
+             surface, and the water content of the line (all the water on it)"
+        );
+        let _ = writeln!(
+            out,
+            "{:>5}  {:>7}  {:>8}  {:>8}",
+            "gauge", "x (m)", "surface", "content"
+        );
+        for (g, (rms, content)) in self.rms.iter().zip(&self.content_rms).enumerate() {
+            let _ = writeln!(
+                out,
+                "{:>5}  {:>7.3}  {rms:>8.4}  {content:>8.4}",
+                GAUGES[g], GAUGE_X[g]
+            );
         }
+        let a = &self.lee_content;
+        let sim = a.simulated.map_or("never".into(), |s| format!("{s:.3} s"));
+        let delay = a.delay().map_or(String::new(), |d| format!(" ({d:+.3} s)"));
+        let _ = writeln!(
+            out,
+            "\nwater on H1's line, standing or not (content >= {} m): {sim}{delay}, measured \
+             height {:.3} s (reported, not judged)",
+            super::ARRIVAL_LEVEL,
+            a.measured
+        );
         out
     }
 
@@ -104,6 +127,12 @@ impl Comparison {
         for (g, rms) in self.rms.iter().enumerate() {
             let _ = writeln!(out, "rms_m,{},0,{rms},", GAUGES[g]);
         }
+        for (g, rms) in self.content_rms.iter().enumerate() {
+            let _ = writeln!(out, "content_rms_m,{},0,{rms},", GAUGES[g]);
+        }
+        let a = &self.lee_content;
+        let sim = a.simulated.map_or(String::new(), |s| format!("{s}"));
+        let _ = writeln!(out, "content_arrival_s,H1,{},{sim},", a.measured);
         out
     }
 }
@@ -111,7 +140,7 @@ impl Comparison {
 /// The files [`write_report`] writes.
 #[derive(Clone, Debug)]
 pub struct ReportFiles {
-    /// Gauge history: t, H1..H4 per reading.
+    /// Gauge history: t, H1..H4, then the contents of their lines, per reading.
     pub series_csv: PathBuf,
     /// The comparison.
     pub comparison_csv: PathBuf,
@@ -135,10 +164,13 @@ pub fn write_report(
             .map(|g| dir.join(format!("kleefsman_{g}.png")))
             .collect(),
     };
-    let mut series = String::from("t_s,H1_m,H2_m,H3_m,H4_m\n");
+    let mut series = String::from(
+        "t_s,H1_m,H2_m,H3_m,H4_m,H1_content_m,H2_content_m,H3_content_m,H4_content_m\n",
+    );
     for s in &run.samples {
         let [a, b, c, d] = s.heights;
-        let _ = writeln!(series, "{},{a},{b},{c},{d}", s.time);
+        let [e, f, g, h] = s.contents;
+        let _ = writeln!(series, "{},{a},{b},{c},{d},{e},{f},{g},{h}", s.time);
     }
     write_text(&files.series_csv, &series)?;
     write_text(&files.comparison_csv, &cmp.csv())?;
@@ -159,6 +191,14 @@ pub fn write_report(
             points: run.heights(g),
             style: SeriesStyle::Line,
         }];
+        if g == super::LEE_GAUGE {
+            // In the lee the water first comes through the air (docs/validation.md).
+            chart_series.push(Series {
+                label: "simulation, water content of the line".into(),
+                points: run.contents(g),
+                style: SeriesStyle::Line,
+            });
+        }
         if !measured.is_empty() {
             chart_series.push(Series {
                 label: "measured (Kleefsman et al. 2005)".into(),

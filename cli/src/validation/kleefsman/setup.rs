@@ -6,7 +6,7 @@ use super::{
 };
 use projfluid::body::Shape;
 use projfluid::boundary::Transform;
-use projfluid::probe::{Gauge, ProbeSet};
+use projfluid::probe::{Gauge, GaugeMeasure, ProbeSet};
 use projfluid::scene::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};
 use projfluid::{Error, Params, SolverKind, Vec3};
 
@@ -170,17 +170,20 @@ impl Setup {
         } else {
             Vec::new()
         };
-        let gauges = GAUGES
-            .iter()
-            .zip(GAUGE_X)
-            .map(|(name, x)| {
-                let [x, _, z] = world_point([x, GAUGE_Y, 0.0]);
-                Gauge {
-                    bottom: Some(0.0),
-                    ..Gauge::new(name, x, z)
-                }
-            })
-            .collect();
+        // The surface at every gauge, then the water content of the same lines.
+        let gauge = |name: &str, x: f64, measure: GaugeMeasure| {
+            let [x, _, z] = world_point([x, GAUGE_Y, 0.0]);
+            Gauge {
+                bottom: Some(0.0),
+                measure,
+                ..Gauge::new(name, x, z)
+            }
+        };
+        let surfaces =
+            (GAUGES.iter().zip(GAUGE_X)).map(|(name, x)| gauge(name, x, GaugeMeasure::Surface));
+        let contents = (GAUGES.iter().zip(GAUGE_X))
+            .map(|(name, x)| gauge(&format!("{name}_content"), x, GaugeMeasure::Content));
+        let gauges = surfaces.chain(contents).collect();
         Scene {
             name: SCENE_NAME.to_string(),
             description: format!(

@@ -249,8 +249,17 @@ mod tests {
         }
         assert_eq!(scene.obstacles.len(), 1);
         let probes = scene.probes.as_ref().unwrap();
-        assert_eq!(probes.gauges.len(), 4);
+        // The four surfaces, then the water content of the same four lines.
+        assert_eq!(probes.gauges.len(), 8);
         assert_eq!((probes.gauges[0].x, probes.gauges[0].z), (0.496, 0.5));
+        for (surface, content) in probes.gauges[..4].iter().zip(&probes.gauges[4..]) {
+            assert_eq!(
+                (surface.measure, content.measure),
+                (GaugeMeasure::Surface, GaugeMeasure::Content)
+            );
+            assert_eq!((surface.x, surface.z), (content.x, content.z));
+            assert_eq!(content.name, format!("{}_content", surface.name));
+        }
         let without = Setup {
             obstacle: false,
             ..Setup::default()

@@ -166,11 +166,12 @@ fn gauges_read_the_water_height_and_ignore_spray() {
     }
 }
 
-/// A water-content gauge reads the depth of the settled water within a quarter spacing, as the
-/// particles show it (top layer + d/2, less the d/2 between the floor's particle plane and
-/// the water) and as the surface gauges read it; within half a spacing of what the volume
-/// N·V/area says (the settled water stands 2–3 % higher than that); spray above the water adds to it exactly what its particles' volumes
-/// put on the line, though the surface gauges do not see it.
+/// A water-content gauge reads the depth of the settled water within a quarter spacing: the
+/// depth the particles show (from the water's bottom face, d/2 above the floor's particle
+/// plane, to its top face, the top layer + d/2) and the surface gauges' height less that d/2;
+/// and within half a spacing of the depth N·V/area (the settled water stands 2–3 % higher
+/// than that). Spray above the water adds to it exactly what its particles' volumes put on
+/// the line, though the surface gauges do not see it.
 #[test]
 fn content_gauges_count_all_the_water_on_the_line() {
     let t = settled_tank();

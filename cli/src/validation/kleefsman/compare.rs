@@ -1,6 +1,6 @@
 //! Simulation against measurement: the surge's arrival at the gauges H3, H2 and H1, the
-//! reservoir's fall at H4, and the RMS difference of every gauge's height; and the same
-//! arrival and differences for the water content of the gauges' lines.
+//! reservoir's fall at H4, and the RMS difference of every gauge's height; and, reported
+//! beside them, the water content's arrival at H1 and its RMS difference at every gauge.
 
 use super::{GAUGES, Measurements, Run};
 use crate::validation::{first_crossing, interpolate};

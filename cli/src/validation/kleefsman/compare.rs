@@ -148,15 +148,17 @@ pub struct Comparison {
 /// Compares `run` with `data` under `tolerances`.
 pub fn compare(run: &Run, data: &Measurements, tolerances: Tolerances) -> Comparison {
     let end = run.end();
+    // The arrival at gauge g of the simulated series `sim` (surface or content).
+    let arrival = |g: usize, sim: Vec<(f64, f64)>| Arrival {
+        gauge: g,
+        measured: first_crossing(&data.heights[g], ARRIVAL_LEVEL)
+            .expect("the measured water reaches every gauge"),
+        simulated: first_crossing(&sim, ARRIVAL_LEVEL),
+        end,
+    };
     let arrivals = ARRIVAL_GAUGES
         .iter()
-        .map(|&g| Arrival {
-            gauge: g,
-            measured: first_crossing(&data.heights[g], ARRIVAL_LEVEL)
-                .expect("the measured water reaches every gauge"),
-            simulated: first_crossing(&run.heights(g), ARRIVAL_LEVEL),
-            end,
-        })
+        .map(|&g| arrival(g, run.heights(g)))
         .collect();
     let h4 = run.heights(RESERVOIR_GAUGE);
     let reservoir = RESERVOIR_TIMES
@@ -175,18 +177,11 @@ pub fn compare(run: &Run, data: &Measurements, tolerances: Tolerances) -> Compar
             .collect();
         (squares.iter().sum::<f64>() / squares.len().max(1) as f64).sqrt()
     };
-    let lee_content = Arrival {
-        gauge: LEE_GAUGE,
-        measured: first_crossing(&data.heights[LEE_GAUGE], ARRIVAL_LEVEL)
-            .expect("the measured water reaches every gauge"),
-        simulated: first_crossing(&run.contents(LEE_GAUGE), ARRIVAL_LEVEL),
-        end,
-    };
     Comparison {
         arrivals,
         reservoir,
         rms: std::array::from_fn(|g| rms_against(g, run.heights(g))),
-        lee_content,
+        lee_content: arrival(LEE_GAUGE, run.contents(LEE_GAUGE)),
         content_rms: std::array::from_fn(|g| rms_against(g, run.contents(g))),
         tolerances,
     }

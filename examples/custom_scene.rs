@@ -23,6 +23,7 @@ fn main() -> Result<(), projfluid::Error> {
             min: [0.0; 3],
             max: [1.0, 0.8, 0.5],
             layers: 1,
+            spacing: None,
         }],
         obstacles: Vec::new(),
         bodies: Vec::new(),

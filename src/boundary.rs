@@ -67,6 +67,17 @@ impl Aabb {
     }
 }
 
+/// The default spacing of a container wall's boundary particles, in particle radii r: the
+/// fluid lattice's own spacing 2r (docs/method.md §7).
+pub const WALL_SPACING: f64 = 2.0;
+
+/// The sparsest container wall allowed, in particle radii r: sparser walls let fluid
+/// particles through.
+pub const MAX_WALL_SPACING: f64 = 2.0;
+
+/// The densest container wall allowed, in particle radii r.
+pub const MIN_WALL_SPACING: f64 = 0.25;
+
 /// Samples the six faces of `container` with square grids of spacing at most `spacing` (m),
 /// edges and corners once. Each extra layer is the same box grown outward by `spacing`.
 pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Vec3> {

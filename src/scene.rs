@@ -166,9 +166,11 @@ impl Scene {
                 min: Vec3::from(c.min),
                 max: Vec3::from(c.max),
             };
-            world
-                .add_container(aabb, c.layers)
-                .map_err(|e| prefixed(e, &format!("container[{i}]: ")))?;
+            let added = match c.spacing {
+                Some(spacing) => world.add_container_spaced(aabb, c.layers, spacing),
+                None => world.add_container(aabb, c.layers),
+            };
+            added.map_err(|e| prefixed(e, &format!("container[{i}]: ")))?;
         }
         for (i, o) in self.obstacles.iter().enumerate() {
             let prefix = format!("obstacles[{i}]: ");

@@ -216,6 +216,7 @@ fn dam_break(
             min: [-0.00625; 3],
             max,
             layers: 1,
+            spacing: None,
         }],
         obstacles: Vec::new(),
         bodies: Vec::new(),

@@ -17,6 +17,10 @@ pub struct ContainerSpec {
     /// Wall thickness in layers of boundary particles (1–3; default 1).
     #[serde(default = "one")]
     pub layers: usize,
+    /// Largest distance between the walls' boundary particles (m), from r/4 to 2r; `None`
+    /// (the key left out) samples them 2r apart (docs/method.md §7).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub spacing: Option<f64>,
 }
 
 fn one() -> usize {

@@ -3,6 +3,7 @@
 use super::{ContainerSpec, FluidBlock, ObstacleSpec, Scene};
 use crate::Error;
 use crate::body::Shape;
+use crate::boundary::{MAX_WALL_SPACING, MIN_WALL_SPACING};
 
 /// The most fluid particles a world accepts (see `World::add_fluid_particles`).
 const MAX_PARTICLES: usize = u32::MAX as usize / 64;
@@ -170,7 +171,8 @@ fn to_json_key(error: Error) -> Error {
     }
 }
 
-/// Finite corners, a non-degenerate box of at least two spacings per axis, 1–3 layers.
+/// Finite corners, a non-degenerate box of at least two spacings per axis, 1–3 layers, a
+/// wall spacing from r/4 to 2r.
 fn check_container(i: usize, c: &ContainerSpec, r: f64) -> Result<(), Error> {
     let field = format!("container[{i}]");
     for (name, v) in [("min", c.min), ("max", c.max)] {
@@ -208,6 +210,18 @@ fn check_container(i: usize, c: &ContainerSpec, r: f64) -> Result<(), Error> {
             format!("{field}.layers"),
             c.layers,
             "must be 1, 2 or 3",
+        ));
+    }
+    let spacings = MIN_WALL_SPACING * r..=MAX_WALL_SPACING * r;
+    if let Some(spacing) = c.spacing.filter(|s| !spacings.contains(s)) {
+        return Err(Error::invalid(
+            format!("{field}.spacing"),
+            spacing,
+            &format!(
+                "must be from r/4 to 2r ({} to {} m)",
+                short(*spacings.start()),
+                short(*spacings.end())
+            ),
         ));
     }
     Ok(())
@@ -411,6 +425,25 @@ mod tests {
             message(Scene::from_json(&text)),
             "container[0].layers must be 1, 2 or 3, got 7"
         );
+        let text = GOOD.replace(
+            "\"max\": [1, 3, 1]",
+            "\"max\": [1, 3, 1], \"spacing\": 0.11",
+        );
+        assert_eq!(
+            message(Scene::from_json(&text)),
+            "container[0].spacing must be from r/4 to 2r (0.0125 to 0.1 m), got 0.11"
+        );
+        // A spacing in range is kept, builds walls that dense, and round-trips.
+        let dense = GOOD.replace(
+            "\"max\": [1, 3, 1]",
+            "\"max\": [1, 3, 1], \"spacing\": 0.05",
+        );
+        let scene = Scene::from_json(&dense).unwrap();
+        assert_eq!(scene.containers[0].spacing, Some(0.05));
+        assert_eq!(Scene::from_json(&scene.to_json()).unwrap(), scene);
+        let walls = |scene: &Scene| scene.build_world().unwrap().boundary_count() as f64;
+        let ratio = walls(&scene) / walls(&Scene::from_json(GOOD).unwrap());
+        assert!((3.5..=4.5).contains(&ratio), "{ratio}");
         let text = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, -3, 1]");
         assert_names(&message(Scene::from_json(&text)), &["container[0]", "-3"]);
     }

@@ -717,3 +717,56 @@ fn a_step_that_falls_back_ends_where_the_plain_iteration_ends() {
     assert!(x == x_plain);
     assert_eq!((force, torque), (force_plain, torque_plain));
 }
+
+/// A container's walls are sampled 2r apart by default and at the spacing asked for, from
+/// r/4 to 2r: at r a quarter of the area per particle, four times as many particles, and
+/// none farther than the spacing from its nearest neighbour on the wall. A spacing outside
+/// the range, or not finite, is refused and adds nothing.
+#[test]
+fn container_walls_are_sampled_at_the_spacing_asked_for() {
+    let tank = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::new(0.6, 0.4, 0.5),
+    };
+    let r = Params::default().particle_radius;
+    let count = |spacing: Option<f64>| {
+        let mut world = World::new(Params::default()).unwrap();
+        match spacing {
+            Some(s) => world.add_container_spaced(tank, 1, s).unwrap(),
+            None => world.add_container(tank, 1).unwrap(),
+        }
+        world
+    };
+    let default = count(None);
+    assert_eq!(
+        default.boundary_count(),
+        count(Some(2.0 * r)).boundary_count()
+    );
+    let dense = count(Some(r));
+    let ratio = dense.boundary_count() as f64 / default.boundary_count() as f64;
+    assert!((3.5..=4.5).contains(&ratio), "{ratio}");
+    for (world, spacing) in [(&default, 2.0 * r), (&dense, r)] {
+        let walls = world.boundary_positions();
+        // The floor's particles: each has another within the spacing, none closer than
+        // half of it.
+        let floor: Vec<Vec3> = walls.iter().copied().filter(|p| p.y == 0.0).collect();
+        for p in floor.iter().take(200) {
+            let nearest = (floor.iter())
+                .filter(|q| *q != p)
+                .map(|q| (q - p).norm())
+                .fold(f64::MAX, f64::min);
+            assert!(nearest <= spacing * (1.0 + 1e-9), "{nearest} > {spacing}");
+            assert!(nearest >= 0.5 * spacing, "{nearest} < {spacing} / 2");
+        }
+    }
+    let mut world = count(None);
+    let before = world.boundary_count();
+    for bad in [f64::NAN, 0.0, 0.2 * r, 2.01 * r, f64::INFINITY] {
+        let err = world.add_container_spaced(tank, 1, bad).unwrap_err();
+        assert!(
+            err.to_string().contains("spacing must be from r/4 to 2r"),
+            "{err}"
+        );
+        assert_eq!(world.boundary_count(), before);
+    }
+}

@@ -246,6 +246,13 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, hi, lo, 1)); /* inverted */
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 0));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box(w, lo, hi, 4));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box_spaced(NULL, lo, hi, 1, 0.025f));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_box_spaced(w, NULL, hi, 1, 0.025f));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 1, NAN));
+    CHECK(strstr(last_msg, "spacing must be from r/4 to 2r") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 1, 0.0f));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 1, 0.06f));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 0, 0.025f));
 
     /* Bad meshes: zero and absurd counts, bad indices and vertices, degenerate triangles,
      * a mesh far too large for the particle radius. */

@@ -138,6 +138,7 @@ impl Setup {
             min: [-wall; 3],
             max: world_point(TANK.map(|l| tidy(l + wall))),
             layers: 1,
+            spacing: None,
         };
         // World frame: length along x, depth along y, width along z.
         let [nx, ny, nz] = self.fluid_count();

@@ -214,14 +214,7 @@ pub unsafe extern "C" fn pf_world_add_container_box(
     layers: c_uint,
 ) -> PfStatus {
     // SAFETY: the caller keeps the contract above.
-    let args = unsafe { Args::trusted() };
-    status_call("pf_world_add_container_box", || {
-        let mut world = args.world(world)?;
-        let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
-        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
-        world.add_container(Aabb { min, max }, layers as usize)?;
-        Ok(())
-    })
+    unsafe { add_container_box("pf_world_add_container_box", world, min, max, layers, None) }
 }
 
 /// Adds a closed box container as `pf_world_add_container_box` does, its walls sampled with
@@ -243,13 +236,36 @@ pub unsafe extern "C" fn pf_world_add_container_box_spaced(
     layers: c_uint,
     spacing: f32,
 ) -> PfStatus {
+    let spacing = Some(f64::from(spacing));
+    let name = "pf_world_add_container_box_spaced";
     // SAFETY: the caller keeps the contract above.
+    unsafe { add_container_box(name, world, min, max, layers, spacing) }
+}
+
+/// The body of both container calls: the box with the default wall spacing, or `spacing`
+/// (m). Reports errors as `name`.
+///
+/// # Safety
+/// As `pf_world_add_container_box`.
+unsafe fn add_container_box(
+    name: &'static str,
+    world: *mut PfWorld,
+    min: *const f32,
+    max: *const f32,
+    layers: c_uint,
+    spacing: Option<f64>,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract of `pf_world_add_container_box`.
     let args = unsafe { Args::trusted() };
-    status_call("pf_world_add_container_box_spaced", || {
+    status_call(name, || {
         let mut world = args.world(world)?;
         let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
         let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
-        world.add_container_spaced(Aabb { min, max }, layers as usize, f64::from(spacing))?;
+        let (container, layers) = (Aabb { min, max }, layers as usize);
+        match spacing {
+            Some(spacing) => world.add_container_spaced(container, layers, spacing)?,
+            None => world.add_container(container, layers)?,
+        }
         Ok(())
     })
 }

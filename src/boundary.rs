@@ -67,9 +67,9 @@ impl Aabb {
     }
 }
 
-/// The default spacing of a container wall's boundary particles, in particle radii r: the
-/// fluid lattice's own spacing 2r (docs/method.md §7).
-pub const WALL_SPACING: f64 = 2.0;
+/// The default spacing of a container wall's boundary particles, in particle radii r: half
+/// the fluid lattice's spacing (docs/method.md §7).
+pub const WALL_SPACING: f64 = 1.0;
 
 /// The sparsest container wall allowed, in particle radii r: sparser walls let fluid
 /// particles through.

@@ -42,8 +42,7 @@ struct Settled {
 }
 
 /// An 8 × 10 × 8 lattice (r = 2.5 cm, mass factor 1, the calm settings) in a closed tank with
-/// its walls d + r/4 from the lattice, as the CLI's hydrostatic validation builds it, and
-/// sampled at r for the pressure reading (docs/method.md §10.3); relaxed
+/// its walls d + r/4 from the lattice, as the CLI's hydrostatic validation builds it; relaxed
 /// for 10 s at 4/s, 2 s free, then 0.25 s solved to τ = 10⁻⁵·r with η = 0, the reading's
 /// tolerance of docs/validation.md (the pressures are read from forces, docs/method.md
 /// §10.3), and read; then spray is added and the gauges read again.
@@ -65,8 +64,7 @@ fn settled_tank() -> &'static Settled {
             max: Vec3::new(extent(8), 1.5 * extent(10), extent(8)),
         };
         let mut world = World::new(params).unwrap();
-        // Walls sampled at r, as docs/method.md §10.3 asks of a tank whose pressures are read.
-        world.add_container_spaced(tank, 1, r).unwrap();
+        world.add_container(tank, 1).unwrap();
         world
             .add_fluid_block(Vec3::repeat(gap), count, Vec3::zeros())
             .unwrap();

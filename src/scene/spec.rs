@@ -18,7 +18,7 @@ pub struct ContainerSpec {
     #[serde(default = "one")]
     pub layers: usize,
     /// Largest distance between the walls' boundary particles (m), from r/4 to 2r; `None`
-    /// (the key left out) samples them 2r apart (docs/method.md §7).
+    /// (the key left out) samples them r apart (docs/method.md §7).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing: Option<f64>,
 }

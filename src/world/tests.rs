@@ -718,8 +718,8 @@ fn a_step_that_falls_back_ends_where_the_plain_iteration_ends() {
     assert_eq!((force, torque), (force_plain, torque_plain));
 }
 
-/// A container's walls are sampled 2r apart by default and at the spacing asked for, from
-/// r/4 to 2r: at r a quarter of the area per particle, four times as many particles, and
+/// A container's walls are sampled r apart by default and at the spacing asked for, from
+/// r/4 to 2r: at 2r four times the area per particle, a quarter of the particles, and
 /// none farther than the spacing from its nearest neighbour on the wall. A spacing outside
 /// the range, or not finite, is refused and adds nothing.
 #[test]
@@ -738,14 +738,11 @@ fn container_walls_are_sampled_at_the_spacing_asked_for() {
         world
     };
     let default = count(None);
-    assert_eq!(
-        default.boundary_count(),
-        count(Some(2.0 * r)).boundary_count()
-    );
-    let dense = count(Some(r));
-    let ratio = dense.boundary_count() as f64 / default.boundary_count() as f64;
+    assert_eq!(default.boundary_count(), count(Some(r)).boundary_count());
+    let sparse = count(Some(2.0 * r));
+    let ratio = default.boundary_count() as f64 / sparse.boundary_count() as f64;
     assert!((3.5..=4.5).contains(&ratio), "{ratio}");
-    for (world, spacing) in [(&default, 2.0 * r), (&dense, r)] {
+    for (world, spacing) in [(&default, r), (&sparse, 2.0 * r)] {
         let walls = world.boundary_positions();
         // The floor's particles: each has another within the spacing, none closer than
         // half of it.

@@ -78,6 +78,18 @@ pub const MAX_WALL_SPACING: f64 = 2.0;
 /// The densest container wall allowed, in particle radii r.
 pub const MIN_WALL_SPACING: f64 = 0.25;
 
+/// `spacing` (m) as a container wall's spacing for particle radius `r` (m): within
+/// [`MIN_WALL_SPACING`]·r to [`MAX_WALL_SPACING`]·r, where a value off by single-precision
+/// rounding (a relative 10⁻⁶, as a C caller's `float` 2r) counts as the limit; `None` outside
+/// the range or not finite.
+pub fn wall_spacing(spacing: f64, r: f64) -> Option<f64> {
+    let (low, high) = (MIN_WALL_SPACING * r, MAX_WALL_SPACING * r);
+    let slack = 1e-6;
+    ((low * (1.0 - slack))..=(high * (1.0 + slack)))
+        .contains(&spacing)
+        .then(|| spacing.clamp(low, high))
+}
+
 /// Samples the six faces of `container` with square grids of spacing at most `spacing` (m),
 /// edges and corners once. Each extra layer is the same box grown outward by `spacing`.
 pub fn sample_box_walls(container: &Aabb, spacing: f64, layers: usize) -> Vec<Vec3> {

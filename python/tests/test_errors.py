@@ -34,6 +34,10 @@ REJECTED: list[tuple[Callable[[projfluid.World], Any], str]] = [
         "pf_world_add_container_box: layers must be 1, 2 or 3, got 4",
     ),
     (
+        lambda w: w.add_container_box((0, 0, 0), (0.5, 0.5, 0.5), spacing=math.nan),
+        "pf_world_add_container_box_spaced: spacing must be from r/4 to 2r",
+    ),
+    (
         lambda w: w.add_mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]]),
         "pf_world_add_mesh: triangles[0][2] must be a vertex index below the vertex count 3, got 3",
     ),

@@ -82,6 +82,15 @@ def test_reads_fill_a_callers_array_in_place(world: projfluid.World) -> None:
         world.velocities(out=frozen)
 
 
+def test_container_walls_take_the_spacing_asked_for() -> None:
+    counts = []
+    for spacing in (None, 0.05):
+        with projfluid.World(projfluid.Params()) as world:
+            world.add_container_box((0, 0, 0), (0.6, 0.4, 0.5), spacing=spacing)
+            counts.append(world.boundary_count)
+    assert 3.5 <= counts[0] / counts[1] <= 4.5
+
+
 def test_inputs_accept_any_array_like_and_are_rounded_to_float32() -> None:
     with projfluid.World(small_params()) as world:
         world.add_container_box([0, 0, 0], np.array([0.5, 0.4, 0.3]))

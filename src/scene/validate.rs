@@ -3,7 +3,7 @@
 use super::{ContainerSpec, FluidBlock, ObstacleSpec, Scene};
 use crate::Error;
 use crate::body::Shape;
-use crate::boundary::{MAX_WALL_SPACING, MIN_WALL_SPACING};
+use crate::boundary::{MAX_WALL_SPACING, MIN_WALL_SPACING, wall_spacing};
 
 /// The most fluid particles a world accepts (see `World::add_fluid_particles`).
 const MAX_PARTICLES: usize = u32::MAX as usize / 64;
@@ -212,15 +212,14 @@ fn check_container(i: usize, c: &ContainerSpec, r: f64) -> Result<(), Error> {
             "must be 1, 2 or 3",
         ));
     }
-    let spacings = MIN_WALL_SPACING * r..=MAX_WALL_SPACING * r;
-    if let Some(spacing) = c.spacing.filter(|s| !spacings.contains(s)) {
+    if let Some(spacing) = c.spacing.filter(|&s| wall_spacing(s, r).is_none()) {
         return Err(Error::invalid(
             format!("{field}.spacing"),
             spacing,
             &format!(
                 "must be from r/4 to 2r ({} to {} m)",
-                short(*spacings.start()),
-                short(*spacings.end())
+                short(MIN_WALL_SPACING * r),
+                short(MAX_WALL_SPACING * r)
             ),
         ));
     }

@@ -6,6 +6,7 @@ use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
 use crate::boundary::{
     Aabb, MAX_WALL_SPACING, MIN_WALL_SPACING, WALL_SPACING, WALLS, sample_box_walls_into,
+    wall_spacing,
 };
 use crate::{Error, Vec3};
 
@@ -151,7 +152,7 @@ impl World {
     ) -> Result<(), Error> {
         check_finite("container", &[container.min, container.max])?;
         let r = self.params.particle_radius;
-        if !(MIN_WALL_SPACING * r..=MAX_WALL_SPACING * r).contains(&spacing) {
+        let Some(spacing) = wall_spacing(spacing, r) else {
             return Err(Error::invalid(
                 "spacing",
                 spacing,
@@ -161,7 +162,7 @@ impl World {
                     MAX_WALL_SPACING * r
                 ),
             ));
-        }
+        };
         let size = container.max - container.min;
         if (0..3).any(|a| size[a] < 2.0 * self.params.spacing()) {
             return Err(Error::invalid(

@@ -720,8 +720,9 @@ fn a_step_that_falls_back_ends_where_the_plain_iteration_ends() {
 
 /// A container's walls are sampled r apart by default and at the spacing asked for, from
 /// r/4 to 2r: at 2r four times the area per particle, a quarter of the particles, and
-/// none farther than the spacing from its nearest neighbour on the wall. A spacing outside
-/// the range, or not finite, is refused and adds nothing.
+/// none farther than the spacing from its nearest neighbour on the wall; the limits as
+/// single-precision numbers count as the limits. A spacing outside the range, or not finite,
+/// is refused and adds nothing.
 #[test]
 fn container_walls_are_sampled_at_the_spacing_asked_for() {
     let tank = Aabb {
@@ -740,6 +741,10 @@ fn container_walls_are_sampled_at_the_spacing_asked_for() {
     let default = count(None);
     assert_eq!(default.boundary_count(), count(Some(r)).boundary_count());
     let sparse = count(Some(2.0 * r));
+    // 2r as a C caller's float, a little above 2r, is 2r.
+    let float = f64::from((2.0 * r) as f32);
+    assert!(float > 2.0 * r);
+    assert_eq!(count(Some(float)).boundary_count(), sparse.boundary_count());
     let ratio = default.boundary_count() as f64 / sparse.boundary_count() as f64;
     assert!((3.5..=4.5).contains(&ratio), "{ratio}");
     for (world, spacing) in [(&default, r), (&sparse, 2.0 * r)] {

@@ -150,17 +150,20 @@ class World(BodiesMixin, FlowMixin):
         xyz = _arrays.rows(positions, 3, np.float32, "positions")
         self._call(lib.pf_world_add_boundary_particles, _arrays.pointer(xyz, c_float), len(xyz))
 
-    def add_container_box(self, min: Vector3, max: Vector3, layers: int = 1) -> None:
+    def add_container_box(
+        self, min: Vector3, max: Vector3, layers: int = 1, spacing: float | None = None
+    ) -> None:
         """Adds a closed box from corner ``min`` to corner ``max`` (m) whose walls are
-        ``layers`` (1–3) layers of boundary particles growing outward."""
+        ``layers`` (1–3) layers of boundary particles growing outward, at most ``spacing``
+        (m, from r/4 to 2r; None: r) apart."""
         if layers < 0:
             raise ValueError(f"layers must not be negative, got {layers}")
-        self._call(
-            lib.pf_world_add_container_box,
-            _arrays.floats3(min, "min"),
-            _arrays.floats3(max, "max"),
-            int(layers),
-        )
+        corners = (_arrays.floats3(min, "min"), _arrays.floats3(max, "max"))
+        if spacing is None:
+            self._call(lib.pf_world_add_container_box, *corners, int(layers))
+        else:
+            spaced = lib.pf_world_add_container_box_spaced
+            self._call(spaced, *corners, int(layers), float(spacing))
 
     def add_mesh(self, vertices: Any, triangles: Any, transform: Transform | None = None) -> None:
         """Adds a static obstacle: the triangle mesh with ``vertices``, an (n, 3) array (m),

@@ -7,6 +7,7 @@ use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid}
 use rayon::prelude::*;
 use std::collections::TryReserveError;
 
+mod field;
 pub mod mesh;
 mod particles;
 pub mod shapes;
@@ -15,6 +16,7 @@ mod undo;
 pub mod winding;
 
 pub(crate) use particles::Boundary;
+pub use field::{WallContribution, WallField};
 pub use transform::Transform;
 pub(crate) use undo::BoundaryCopy;
 

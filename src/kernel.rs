@@ -89,6 +89,29 @@ impl CubicKernel {
         2.0 * one_side
     }
 
+    /// The kernel summed over a whole plane at distance `z` (m) from its centre,
+    /// P(z) = ∫ W dA = 2π ∫_|z|^H W(u) u du, in 1/m: what a uniform layer of unit mass per
+    /// area adds to the density at distance z (docs/method.md §7). Zero at and beyond H; it
+    /// integrates to 1 over z (tested). In closed form, with a = |z|/H, T = (1 − a)₊ and
+    /// T' = (½ − a)₊: P = 2πσH²·(T⁴/2 − 2T⁵/5 − T'⁴ + 8T'⁵/5).
+    #[inline]
+    pub fn plane_integral(&self, z: f64) -> f64 {
+        let a = z.abs() * self.inverse_support;
+        let outer = (1.0 - a).max(0.0);
+        let inner = (0.5 - a).max(0.0);
+        let (o4, i4) = (outer.powi(4), inner.powi(4));
+        let shape = 0.5 * o4 - 0.4 * o4 * outer - i4 + 1.6 * i4 * inner;
+        2.0 * PI * self.sigma * shape / (self.inverse_support * self.inverse_support)
+    }
+
+    /// The derivative dP/dz of [`CubicKernel::plane_integral`] at signed distance `z` (m),
+    /// −2πW(|z|)·z, in 1/m²; its magnitude is at most 2πσH/4 and its second derivative
+    /// at most 2πσ in magnitude.
+    #[inline]
+    pub fn plane_integral_slope(&self, z: f64) -> f64 {
+        -2.0 * PI * self.w(z.abs()) * z
+    }
+
     /// The largest curvature of W, in 1/m⁵: a bound M on every eigenvalue of the Hessian of
     /// W(|r|) over all offsets r, M = 6σ/H². With f(q) = W/σ the eigenvalues are f''(q)/H²
     /// along r and f'(q)/(qH²) across it; f'' = 36q − 12 for q ≤ ½ and 12(1 − q) beyond, at
@@ -217,6 +240,40 @@ mod tests {
         assert!(kernel.line_integral(0.02) < kernel.line_integral(0.01));
         assert_eq!(kernel.line_integral(h), 0.0);
         assert_eq!(kernel.line_integral(-0.2), 0.0);
+    }
+
+    /// The plane integral integrates to 1 over the distance, is the brute-force sum of W over
+    /// a fine lattice in the plane, and its slope is its derivative.
+    #[test]
+    fn plane_integral_is_the_kernel_summed_over_a_plane() {
+        let h = 0.1;
+        let k = CubicKernel::new(h);
+        let n = 4000;
+        let dz = 2.0 * h / n as f64;
+        let total: f64 = (0..n)
+            .map(|i| k.plane_integral(-h + (i as f64 + 0.5) * dz) * dz)
+            .sum();
+        assert!((total - 1.0).abs() < 1e-6, "∫P dz = {total}");
+        let step = h / 200.0;
+        for z in [0.0, 0.013, 0.05, 0.071, 0.099] {
+            let cells = (h / step) as i64 + 1;
+            let brute: f64 = (-cells..=cells)
+                .flat_map(|i| (-cells..=cells).map(move |j| (i, j)))
+                .map(|(i, j)| {
+                    let (u, v) = (i as f64 * step, j as f64 * step);
+                    k.w((u * u + v * v + z * z).sqrt()) * step * step
+                })
+                .sum();
+            let p = k.plane_integral(z);
+            assert!((p - brute).abs() < 1e-3 * k.plane_integral(0.0), "z {z}: {p} against {brute}");
+            assert_eq!(p, k.plane_integral(-z));
+            let e = 1e-7;
+            let numeric = (k.plane_integral(z + e) - k.plane_integral(z - e)) / (2.0 * e);
+            let slope = k.plane_integral_slope(z);
+            assert!((numeric - slope).abs() < 1e-5 * k.plane_integral(0.0) / h, "z {z}");
+        }
+        assert_eq!(k.plane_integral(h), 0.0);
+        assert_eq!(k.plane_integral(1.5 * h), 0.0);
     }
 
     #[test]

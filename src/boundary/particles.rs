@@ -6,7 +6,7 @@
 //! particles of moving bodies are placed anew before every step at the bodies' poses, with
 //! the masses computed in their own frames, and sorted in among the static ones.
 
-use super::WALLS;
+use super::{WALLS, WallField};
 use super::undo::BoundaryCopy;
 use crate::Vec3;
 use crate::boundary::akinci_volumes;
@@ -28,6 +28,8 @@ pub(crate) struct Boundary {
     pub owner: Vec<u32>,
     /// Where each grid cell's particles lie in `positions`.
     pub table: CellTable,
+    /// Container walls without particles (docs/method.md §7).
+    pub walls: Vec<WallField>,
     /// Set when particles were added or the grid changed: sort and volumes must be redone.
     pub dirty: bool,
     /// Whether the body of each owner index moves (its particles are placed every step).

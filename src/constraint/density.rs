@@ -32,7 +32,7 @@ impl DensityConstraint {
                 nb.boundary_psi[b] * k.w((xi - nb.boundary_positions.at(b)).norm())
             })
             .sum();
-        self.mass * (k.w_zero() + fluid) + boundary
+        self.mass * (k.w_zero() + fluid) + boundary + self.walls_at(xi, nb).density
     }
 
     /// Fills `m` with the fluid members of stencil i, particle i at `xi` and its neighbours
@@ -108,7 +108,9 @@ impl DensityConstraint {
             *len = (rx * rx + ry * ry + rz * rz).sqrt();
             *w = psi * k.w(*len);
         }
-        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n)
+        scratch.wall_at = xi;
+        scratch.wall = self.walls_at(xi, nb);
+        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n) + scratch.wall.density
     }
 
     /// SPH density ρ_i (kg/m³) of every fluid particle at `positions`, written into `out`.

@@ -23,11 +23,12 @@ impl DensityConstraint {
         for ((c, len), psi) in bm.values[..lanes].iter_mut().zip(&bm.len).zip(&bm.psi) {
             *c = kernel.grad_w_coefficient(*len) * psi;
         }
-        let boundary = Vec3::new(
+        let boundary = (Vec3::new(
             ordered_dot(&bm.rx[..lanes], &bm.values),
             ordered_dot(&bm.ry[..lanes], &bm.values),
             ordered_dot(&bm.rz[..lanes], &bm.values),
-        ) / self.rest_density;
+        ) + scratch.wall.gradient)
+            / self.rest_density;
         let m = &mut scratch.members;
         for ((((((gx, gy), gz), g2), rx), ry), (rz, len)) in m.gx[..padded(m.n)]
             .iter_mut()
@@ -64,6 +65,7 @@ impl DensityConstraint {
         &self,
         lambda: f64,
         shift: Vec3,
+        nb: &Neighborhood,
         scratch: &mut Scratch,
     ) -> f64 {
         let k = &self.kernel;
@@ -97,7 +99,12 @@ impl DensityConstraint {
             let (dx, dy, dz) = (rx + shift.x, ry + shift.y, rz + shift.z);
             *w = psi * k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
-        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n)
+        let walls = if scratch.wall.curvature > 0.0 {
+            self.walls_at(scratch.wall_at + shift, nb).density
+        } else {
+            0.0
+        };
+        self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n) + walls
     }
 
     /// Whether the first projection step (λ, with the centre's weight `w_i` and gradient
@@ -140,8 +147,12 @@ impl DensityConstraint {
         let psi = members_sum(&bm.psi, bm.n);
         let linear = self.rest_density * lambda * (w_i * grad_i2 + weighted);
         let spread = 2.0 * self.mass * (n as f64 * shift + members_shift);
-        let quadratic = 0.5 * self.kernel.curvature_bound() * (spread + psi * shift);
-        rho + linear + quadratic <= self.rest_density * (1.0 - RELAXATION_MARGIN)
+        let walls = 0.5 * scratch.wall.curvature * shift;
+        let quadratic = 0.5 * self.kernel.curvature_bound() * (spread + psi * shift) + walls;
+        // The walls' curvature bounds moves shorter than H only.
+        let short = scratch.wall.curvature == 0.0
+            || shift < self.kernel.support_radius() * self.kernel.support_radius();
+        short && rho + linear + quadratic <= self.rest_density * (1.0 - RELAXATION_MARGIN)
     }
 }
 
@@ -184,7 +195,7 @@ mod tests {
                 let shift = grad_i * (lambda * w_i);
                 if constraint.first_step_surely_relaxes(rho, lambda, grad_i, w_i, &mut scratch) {
                     certified += 1;
-                    let after = constraint.first_step_density(lambda, shift, &mut scratch);
+                    let after = constraint.first_step_density(lambda, shift, &nb, &mut scratch);
                     assert!(
                         after <= constraint.rest_density,
                         "spacing factor {factor}, particle {i}: ρ {after} after the step"

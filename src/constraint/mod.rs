@@ -15,6 +15,8 @@ mod stencil;
 pub use gather::Corrections;
 pub use projection::Projection;
 
+use crate::Vec3;
+use crate::boundary::{WallContribution, WallField};
 use crate::kernel::CubicKernel;
 use crate::neighbors::{NeighborLists, PointsByComponent};
 use crate::params::ProjectionWeight;
@@ -62,8 +64,9 @@ const REGULARIZATION: f64 = 1e-6;
 /// evaluation (≈ 10⁻¹⁴).
 const RELAXATION_MARGIN: f64 = 1e-9;
 
-/// Everything a constraint reads during one time step: the fluid's neighbour lists and the
-/// static boundary particles with their Akinci masses ψ_b = ρ0·V_b (kg).
+/// Everything a constraint reads during one time step: the fluid's neighbour lists, the
+/// static boundary particles with their Akinci masses ψ_b = ρ0·V_b (kg), and the container
+/// walls that are fields rather than particles.
 #[derive(Clone, Copy)]
 pub struct Neighborhood<'a> {
     /// Fluid neighbours of each fluid particle (j ≠ i).
@@ -77,6 +80,8 @@ pub struct Neighborhood<'a> {
     /// The weight w_j of every fluid particle in a projection
     /// ([`DensityConstraint::weights`]).
     pub weights: &'a [f64],
+    /// Container walls without particles (docs/method.md §7).
+    pub walls: &'a [WallField],
 }
 
 /// The fluid density constraint with the constants of the local projection.
@@ -110,6 +115,21 @@ pub struct DensityConstraint {
 
 /// The fixture of the stencil and first-step tests: a jittered cluster of fluid particles
 /// over a floor of boundary particles, and the constraint it is tested with.
+impl DensityConstraint {
+    /// What the container walls without particles add at `x` (m), summed over them.
+    #[inline(always)]
+    pub(crate) fn walls_at(&self, x: Vec3, nb: &Neighborhood) -> WallContribution {
+        let mut sum = WallContribution::default();
+        for field in nb.walls {
+            let one = field.at(x, &self.kernel);
+            sum.density += one.density;
+            sum.gradient += one.gradient;
+            sum.curvature += one.curvature;
+        }
+        sum
+    }
+}
+
 #[cfg(test)]
 mod test_cluster {
     use super::*;
@@ -138,6 +158,7 @@ mod test_cluster {
                 boundary_positions: &self.bx_components,
                 boundary_psi: &self.psi,
                 weights: &self.weights,
+                walls: &[],
             }
         }
     }

@@ -3,6 +3,7 @@
 //! one fixed order.
 
 use crate::Vec3;
+use crate::boundary::WallContribution;
 use crate::reserve::reserve_total;
 use std::cell::RefCell;
 use std::collections::TryReserveError;
@@ -26,6 +27,10 @@ pub(super) struct Scratch {
     pub(super) members: Members,
     pub(super) boundary: BoundaryMembers,
     pub(super) grads: Vec<Vec3>,
+    /// The iterate x_i of the last [`DensityConstraint::first_density`] and what the
+    /// container walls without particles add there.
+    pub(super) wall_at: Vec3,
+    pub(super) wall: WallContribution,
 }
 
 thread_local! {

@@ -52,6 +52,7 @@ pub(super) fn finish(
         boundary_positions: &boundary.positions,
         boundary_psi: &boundary.psi,
         weights: &b.weights,
+        walls: &boundary.walls,
     };
     if outcome.densities_known {
         // The local step that ended the iteration evaluated them at these positions.

@@ -97,6 +97,7 @@ pub(super) fn iterate(
         boundary_positions: &boundary.positions,
         boundary_psi: &boundary.psi,
         weights: &b.weights,
+        walls: &boundary.walls,
     };
     chebyshev.reset();
     let mut accelerate = params.solver == SolverKind::Chebyshev;

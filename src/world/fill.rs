@@ -199,7 +199,13 @@ impl World {
             .map_err(boundary_oom)?;
         sample_box_walls_into(&container, spacing, layers, &mut samples);
         self.containers.try_reserve(1).map_err(boundary_oom)?;
+        if std::env::var_os("PF_FIELD").is_some() {
+            let k = self.constraint.kernel;
+            let rho0 = self.params.rest_density;
+            self.boundary.walls.push(crate::boundary::WallField::new(container, spacing, &k, rho0));
+        } else {
         self.add_boundary_particles(&samples)?;
+        }
         self.containers.push(container);
         Ok(())
     }

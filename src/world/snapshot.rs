@@ -4,7 +4,7 @@
 
 use super::World;
 use crate::Vec3;
-use crate::boundary::{Aabb, akinci_volumes};
+use crate::boundary::{Aabb, WallField, akinci_volumes};
 use crate::constraint::Neighborhood;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 
@@ -29,6 +29,8 @@ pub(crate) struct Snapshot {
     pub boundary: PointsByComponent,
     /// Akinci mass ψ_b = ρ0·V_b (kg) of each of `boundary` (docs/method.md §2.6).
     pub psi: Vec<f64>,
+    /// The container walls without particles (docs/method.md §7).
+    pub walls: Vec<WallField>,
 }
 
 impl Snapshot {
@@ -103,6 +105,7 @@ impl World {
             boundary_table,
             boundary: bx,
             psi,
+            walls: boundary.walls.clone(),
         })
     }
 
@@ -131,6 +134,7 @@ impl World {
             boundary_positions: &snapshot.boundary,
             boundary_psi: &snapshot.psi,
             weights: &weights,
+            walls: &snapshot.walls,
         })
     }
 

@@ -6,7 +6,7 @@
 
 use projfluid::boundary::Transform;
 use projfluid::boundary::shapes::Shapes;
-use projfluid::scene::{ContainerSpec, FluidBlock, OutputSpec, Scene};
+use projfluid::scene::{ContainerSpec, ContainerWalls, FluidBlock, OutputSpec, Scene};
 use projfluid::{Params, SolverKind, Vec3};
 
 fn main() -> Result<(), projfluid::Error> {
@@ -22,6 +22,7 @@ fn main() -> Result<(), projfluid::Error> {
         containers: vec![ContainerSpec {
             min: [0.0; 3],
             max: [1.0, 0.8, 0.5],
+            walls: ContainerWalls::Field,
             layers: 1,
             spacing: None,
         }],

@@ -5,6 +5,7 @@ use crate::Vec3;
 use crate::kernel::CubicKernel;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
 use std::collections::TryReserveError;
 
 mod field;
@@ -15,14 +16,26 @@ pub mod transform;
 mod undo;
 pub mod winding;
 
-pub(crate) use particles::Boundary;
 pub use field::{WallContribution, WallField};
+pub(crate) use particles::Boundary;
 pub use transform::Transform;
 pub(crate) use undo::BoundaryCopy;
 
 /// The owner index of boundary particles that belong to walls and static obstacles rather
 /// than to a body.
 pub(crate) const WALLS: u32 = u32::MAX;
+
+/// What a container's walls are (docs/method.md §7).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContainerWalls {
+    /// Each wall a smooth field: what a wall of boundary particles r apart adds to the
+    /// fluid's density, averaged along the wall, with no particles to search or sum over.
+    #[default]
+    Field,
+    /// Each wall sampled with boundary particles (`layers`, `spacing`).
+    Particles,
+}
 
 /// An axis-aligned box, corners in metres.
 #[derive(Clone, Copy, Debug, PartialEq)]

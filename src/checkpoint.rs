@@ -8,7 +8,7 @@
 //!
 //! Layout: the magic `PFCHECK3`; the length (u64, little-endian) of a JSON header, the
 //! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
-//! containers, grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
+//! containers (and which of them have walls that are fields), grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
 //! velocities and loads, the next particle id, the removed count, sinks, domain and
 //! emitters); the fluid positions, velocities and densities as f64 triples/values, the
 //! particle ids as u64, the static boundary positions as f64 triples and their owners as
@@ -70,6 +70,7 @@ pub fn write_checkpoint(
         steps: state.steps,
         next_dt: state.next_dt,
         containers: state.containers.iter().map(saved_box).collect(),
+        field_walls: state.field_walls.iter().map(saved_box).collect(),
         grid: state.grid,
         grid_capped: state.grid_capped,
         boundary_dirty: !state.boundary_sorted,
@@ -216,6 +217,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         bodies,
         boundary_sorted: !header.boundary_dirty,
         containers: header.containers.iter().map(aabb).collect(),
+        field_walls: header.field_walls.iter().map(aabb).collect(),
         sinks: header.sinks.iter().map(aabb).collect(),
         domain: header.domain.as_ref().map(aabb),
         emitters: header.emitters.iter().map(SavedEmitter::state).collect(),

@@ -265,12 +265,18 @@ mod tests {
                 })
                 .sum();
             let p = k.plane_integral(z);
-            assert!((p - brute).abs() < 1e-3 * k.plane_integral(0.0), "z {z}: {p} against {brute}");
+            assert!(
+                (p - brute).abs() < 1e-3 * k.plane_integral(0.0),
+                "z {z}: {p} against {brute}"
+            );
             assert_eq!(p, k.plane_integral(-z));
             let e = 1e-7;
             let numeric = (k.plane_integral(z + e) - k.plane_integral(z - e)) / (2.0 * e);
             let slope = k.plane_integral_slope(z);
-            assert!((numeric - slope).abs() < 1e-5 * k.plane_integral(0.0) / h, "z {z}");
+            assert!(
+                (numeric - slope).abs() < 1e-5 * k.plane_integral(0.0) / h,
+                "z {z}"
+            );
         }
         assert_eq!(k.plane_integral(h), 0.0);
         assert_eq!(k.plane_integral(1.5 * h), 0.0);

@@ -19,6 +19,7 @@ mod spec;
 mod test_support;
 mod validate;
 
+pub use crate::boundary::ContainerWalls;
 pub use bodies::{BodyShape, MotionSpec, SceneBody};
 pub use spec::{
     BoxSpec, ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
@@ -166,9 +167,12 @@ impl Scene {
                 min: Vec3::from(c.min),
                 max: Vec3::from(c.max),
             };
-            let added = match c.spacing {
-                Some(spacing) => world.add_container_spaced(aabb, c.layers, spacing),
-                None => world.add_container(aabb, c.layers),
+            let added = match (c.walls, c.spacing) {
+                (ContainerWalls::Field, _) => world.add_container_field(aabb),
+                (ContainerWalls::Particles, Some(spacing)) => {
+                    world.add_container_spaced(aabb, c.layers, spacing)
+                }
+                (ContainerWalls::Particles, None) => world.add_container(aabb, c.layers),
             };
             added.map_err(|e| prefixed(e, &format!("container[{i}]: ")))?;
         }

@@ -6,8 +6,8 @@
 //! particles of moving bodies are placed anew before every step at the bodies' poses, with
 //! the masses computed in their own frames, and sorted in among the static ones.
 
-use super::{WALLS, WallField};
 use super::undo::BoundaryCopy;
+use super::{WALLS, WallField};
 use crate::Vec3;
 use crate::boundary::akinci_volumes;
 use crate::kernel::CubicKernel;

@@ -18,6 +18,9 @@ pub(super) struct Header {
     pub steps: u64,
     pub next_dt: f64,
     pub containers: Vec<SavedBox>,
+    /// The containers whose walls are fields (absent in checkpoints from before them).
+    #[serde(default)]
+    pub field_walls: Vec<SavedBox>,
     pub grid: Option<GridParts>,
     pub grid_capped: bool,
     pub boundary_dirty: bool,

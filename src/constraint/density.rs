@@ -32,7 +32,7 @@ impl DensityConstraint {
                 nb.boundary_psi[b] * k.w((xi - nb.boundary_positions.at(b)).norm())
             })
             .sum();
-        self.mass * (k.w_zero() + fluid) + boundary + self.walls_at(xi, nb).density
+        self.mass * (k.w_zero() + fluid) + boundary + self.walls_at(xi, nb.walls).density
     }
 
     /// Fills `m` with the fluid members of stencil i, particle i at `xi` and its neighbours
@@ -109,7 +109,7 @@ impl DensityConstraint {
             *w = psi * k.w(*len);
         }
         scratch.wall_at = xi;
-        scratch.wall = self.walls_at(xi, nb);
+        scratch.wall = self.walls_at(xi, nb.walls);
         self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n) + scratch.wall.density
     }
 

@@ -100,7 +100,7 @@ impl DensityConstraint {
             *w = psi * k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
         let walls = if scratch.wall.curvature > 0.0 {
-            self.walls_at(scratch.wall_at + shift, nb).density
+            self.walls_at(scratch.wall_at + shift, nb.walls).density
         } else {
             0.0
         };

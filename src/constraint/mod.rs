@@ -118,9 +118,9 @@ pub struct DensityConstraint {
 impl DensityConstraint {
     /// What the container walls without particles add at `x` (m), summed over them.
     #[inline(always)]
-    pub(crate) fn walls_at(&self, x: Vec3, nb: &Neighborhood) -> WallContribution {
+    pub(crate) fn walls_at(&self, x: Vec3, walls: &[WallField]) -> WallContribution {
         let mut sum = WallContribution::default();
-        for field in nb.walls {
+        for field in walls {
             let one = field.at(x, &self.kernel);
             sum.density += one.density;
             sum.gradient += one.gradient;

@@ -152,7 +152,7 @@ impl DensityConstraint {
                 kernel.grad_w(&(pi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
             })
             .sum::<Vec3>()
-            + self.walls_at(pi, nb).gradient)
+            + self.walls_at(pi, nb.walls).gradient)
             / self.rest_density;
         let mut denominator = 0.0;
         grads.clear();
@@ -236,7 +236,9 @@ impl DensityConstraint {
                 (0, _) => self.first_density(i, pi, x, nb, scratch),
                 (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
-                (_, false) => self.first_step_density(first_lambda, out.self_correction, nb, scratch),
+                (_, false) => {
+                    self.first_step_density(first_lambda, out.self_correction, nb, scratch)
+                }
             };
             if step == 0 {
                 out.density = rho;

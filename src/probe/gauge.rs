@@ -197,7 +197,8 @@ impl Line {
                 .fluid
                 .iter()
                 .copied()
-                .chain(snapshot.boundary.iter()))
+                .chain(snapshot.boundary.iter())
+                .chain(snapshot.walls.iter().map(|w| w.container().max)))
             .map(|p| p.y)
             .fold(f64::NEG_INFINITY, f64::max);
             highest + world.params().support_radius()
@@ -241,7 +242,8 @@ impl Line {
 }
 
 /// The fluid fraction φ(p) = Σ_j (m/ρ0)·W(p − x_j) + Σ_b (ψ_b/ρ0)·W(p − x_b) at each of
-/// `points`, over the fluid and boundary particles of `snapshot`: 1 inside water at rest
+/// `points`, over the fluid and boundary particles of `snapshot` (and the walls that are
+/// fields, by what they add to a density): 1 inside water at rest
 /// density and next to walls, ½ at a flat free surface, 0 in air (docs/method.md §10.3).
 fn fraction(
     world: &World,
@@ -264,7 +266,8 @@ fn fraction(
                 .sum();
             let walls: f64 = (boundary_lists.of(k).iter())
                 .map(|&b| s.psi[b as usize] * kernel.w((p - s.boundary.at(b as usize)).norm()))
-                .sum();
+                .sum::<f64>()
+                + c.walls_at(*p, &s.walls).density;
             volume * fluid + walls / c.rest_density
         })
         .collect()

@@ -138,31 +138,38 @@ impl Field<'_> {
     /// Constraint j's correction of its own centre has the boundary part
     /// k·λ_j·w_j·(1/ρ0)·Σ_b ψ_b·∇W(x_j − x_b) (docs/method.md §11.3); its reaction on b, with
     /// k·λ_j·w_j = −p_j·V (docs/method.md §10.1), is f_b = Σ_j p_j·V·(ψ_b/ρ0)·∇W(x_j − x_b).
+    ///
+    /// On a wall that is a field, the same over the particles it stands for
+    /// ([`crate::boundary::WallField::particles_near`]), `x` within r/2 of the wall's plane.
     fn wall_stress(&self, x: Vec3, (fluid, boundary): &mut (NeighborLists, NeighborLists)) -> f64 {
         let (s, c) = (self.snapshot, &self.world.constraint);
         let h = c.kernel.support_radius();
-        s.boundary_near(&[x], h, boundary);
-        let near: Vec<u32> = boundary.of(0).to_vec();
+        let tolerance = 0.5 * self.world.params().particle_radius;
+        let mut near: Vec<(Vec3, f64)> = (s.walls.iter())
+            .flat_map(|w| w.particles_near(x, h, tolerance))
+            .collect();
+        if near.is_empty() {
+            s.boundary_near(&[x], h, boundary);
+            let particles = boundary.of(0).iter().map(|&b| b as usize);
+            near = particles.map(|b| (s.boundary.at(b), s.psi[b])).collect();
+        }
         if near.is_empty() {
             return f64::NAN;
         }
-        let at: Vec<Vec3> = near.iter().map(|&b| s.boundary.at(b as usize)).collect();
+        let at: Vec<Vec3> = near.iter().map(|&(xb, _)| xb).collect();
         s.fluid_near(&at, h, fluid);
         let volume = c.mass / c.rest_density;
         let stress: Vec3 = near
             .iter()
-            .zip(&at)
             .enumerate()
-            .map(|(k, (&b, xb))| {
+            .map(|(k, &(xb, psi))| {
                 let force: Vec3 = (fluid.of(k).iter())
                     .map(|&j| {
                         let xj = s.fluid[j as usize];
                         self.pressures[j as usize] * c.kernel.grad_w(&(xj - xb))
                     })
                     .sum();
-                force
-                    * (volume * s.psi[b as usize] / c.rest_density)
-                    * planar_weight((x - xb).norm(), h)
+                force * (volume * psi / c.rest_density) * planar_weight((x - xb).norm(), h)
             })
             .sum();
         stress.norm()

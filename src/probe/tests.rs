@@ -1,6 +1,7 @@
 //! Probes in a settled tank, their determinism, and the checks of probe definitions.
 
 use super::*;
+use crate::boundary::ContainerWalls;
 use crate::scene::Scene;
 use crate::{Params, Vec3};
 use std::sync::OnceLock;
@@ -8,6 +9,9 @@ use std::sync::OnceLock;
 /// Gravity (m/s²) and rest density (kg/m³) of the tank.
 const G: f64 = 9.81;
 const RHO0: f64 = 1000.0;
+
+/// Both kinds of container walls, each of which the settled tank is built with.
+const WALLS: [ContainerWalls; 2] = [ContainerWalls::Particles, ContainerWalls::Field];
 
 /// What the settled tank showed.
 struct Settled {
@@ -42,13 +46,14 @@ struct Settled {
 }
 
 /// An 8 × 10 × 8 lattice (r = 2.5 cm, mass factor 1, the calm settings) in a closed tank with
-/// its walls d + r/4 from the lattice, as the CLI's hydrostatic validation builds it; relaxed
+/// its walls (`walls`: fields or particles) d + r/4 from the lattice, as the CLI's
+/// hydrostatic validation builds it; relaxed
 /// for 10 s at 4/s, 2 s free, then 0.25 s solved to τ = 10⁻⁵·r with η = 0, the reading's
 /// tolerance of docs/validation.md (the pressures are read from forces, docs/method.md
 /// §10.3), and read; then spray is added and the gauges read again.
-fn settled_tank() -> &'static Settled {
-    static TANK: OnceLock<Settled> = OnceLock::new();
-    TANK.get_or_init(|| {
+fn settled_tank(walls: ContainerWalls) -> &'static Settled {
+    static TANKS: [OnceLock<Settled>; 2] = [OnceLock::new(), OnceLock::new()];
+    TANKS[walls as usize].get_or_init(|| {
         let r = 0.025;
         let params = Params {
             mass_factor: 1.0,
@@ -64,7 +69,7 @@ fn settled_tank() -> &'static Settled {
             max: Vec3::new(extent(8), 1.5 * extent(10), extent(8)),
         };
         let mut world = World::new(params).unwrap();
-        world.add_container(tank, 1).unwrap();
+        world.add_container_with(tank, walls).unwrap();
         world
             .add_fluid_block(Vec3::repeat(gap), count, Vec3::zeros())
             .unwrap();
@@ -167,23 +172,25 @@ fn settled_tank() -> &'static Settled {
 /// above the water changes nothing.
 #[test]
 fn gauges_read_the_water_height_and_ignore_spray() {
-    let t = settled_tank();
-    for (gauge, height) in t.probes.gauges.iter().zip(&t.reading.heights) {
-        assert!(
-            (height - t.volume_surface).abs() <= t.spacing,
-            "{}: {height:.4} m, N·V/area + d/2 = {:.4} m",
-            gauge.name,
-            t.volume_surface
-        );
-        assert!(
-            (height - t.particle_surface).abs() <= 0.5 * t.spacing,
-            "{}: {height:.4} m, top layer + d/2 = {:.4} m",
-            gauge.name,
-            t.particle_surface
-        );
-    }
-    for (a, b) in t.reading.heights.iter().zip(&t.with_spray) {
-        assert!((a - b).abs() <= 1e-9, "spray moved a gauge from {a} to {b}");
+    for walls in WALLS {
+        let t = settled_tank(walls);
+        for (gauge, height) in t.probes.gauges.iter().zip(&t.reading.heights) {
+            assert!(
+                (height - t.volume_surface).abs() <= t.spacing,
+                "{walls:?} walls, {}: {height:.4} m, N·V/area + d/2 = {:.4} m",
+                gauge.name,
+                t.volume_surface
+            );
+            assert!(
+                (height - t.particle_surface).abs() <= 0.5 * t.spacing,
+                "{}: {height:.4} m, top layer + d/2 = {:.4} m",
+                gauge.name,
+                t.particle_surface
+            );
+        }
+        for (a, b) in t.reading.heights.iter().zip(&t.with_spray) {
+            assert!((a - b).abs() <= 1e-9, "spray moved a gauge from {a} to {b}");
+        }
     }
 }
 
@@ -195,45 +202,47 @@ fn gauges_read_the_water_height_and_ignore_spray() {
 /// the line, though the surface gauges do not see it.
 #[test]
 fn content_gauges_count_all_the_water_on_the_line() {
-    let t = settled_tank();
-    let (gauges, before, after) = &t.content;
-    for ((gauge, content), (g, surface)) in gauges
-        .iter()
-        .zip(before)
-        .zip(t.probes.gauges.iter().zip(&t.reading.heights))
-    {
-        let depth = t.particle_surface - 0.5 * t.spacing;
-        assert!(
-            (content - depth).abs() <= 0.25 * t.spacing,
-            "{}: {content:.4} m, top layer = {depth:.4} m",
-            gauge.name
-        );
-        assert!(
-            (content - t.volume_depth).abs() <= 0.5 * t.spacing,
-            "{}: {content:.4} m, N·V/area = {:.4} m",
-            gauge.name,
-            t.volume_depth
-        );
-        // The standing column's surface lies d/2 above the content's depth (its bottom face
-        // is d/2 above the floor's particle plane).
-        assert!(
-            (surface - content - 0.5 * t.spacing).abs() <= 0.25 * t.spacing,
-            "{}: surface {surface:.4} m, content {content:.4} m",
-            g.name
-        );
-    }
-    for ((gauge, a), b) in gauges.iter().zip(before).zip(after) {
-        let spray: f64 = (t.spray.iter())
-            .map(|p| t.kernel.line_integral((p.x - gauge.x).hypot(p.z - gauge.z)))
-            .sum::<f64>()
-            * t.particle_volume;
-        assert!(spray > 0.5 * t.spacing, "{}: spray {spray}", gauge.name);
-        assert!(
-            (b - a - spray).abs() <= 1e-9,
-            "{}: the spray added {} m, its volume on the line is {spray} m",
-            gauge.name,
-            b - a
-        );
+    for walls in WALLS {
+        let t = settled_tank(walls);
+        let (gauges, before, after) = &t.content;
+        for ((gauge, content), (g, surface)) in gauges
+            .iter()
+            .zip(before)
+            .zip(t.probes.gauges.iter().zip(&t.reading.heights))
+        {
+            let depth = t.particle_surface - 0.5 * t.spacing;
+            assert!(
+                (content - depth).abs() <= 0.25 * t.spacing,
+                "{walls:?} walls, {}: {content:.4} m, top layer = {depth:.4} m",
+                gauge.name
+            );
+            assert!(
+                (content - t.volume_depth).abs() <= 0.5 * t.spacing,
+                "{}: {content:.4} m, N·V/area = {:.4} m",
+                gauge.name,
+                t.volume_depth
+            );
+            // The standing column's surface lies d/2 above the content's depth (its bottom face
+            // is d/2 above the floor's particle plane).
+            assert!(
+                (surface - content - 0.5 * t.spacing).abs() <= 0.25 * t.spacing,
+                "{}: surface {surface:.4} m, content {content:.4} m",
+                g.name
+            );
+        }
+        for ((gauge, a), b) in gauges.iter().zip(before).zip(after) {
+            let spray: f64 = (t.spray.iter())
+                .map(|p| t.kernel.line_integral((p.x - gauge.x).hypot(p.z - gauge.z)))
+                .sum::<f64>()
+                * t.particle_volume;
+            assert!(spray > 0.5 * t.spacing, "{}: spray {spray}", gauge.name);
+            assert!(
+                (b - a - spray).abs() <= 1e-9,
+                "{}: the spray added {} m, its volume on the line is {spray} m",
+                gauge.name,
+                b - a
+            );
+        }
     }
 }
 
@@ -243,36 +252,38 @@ fn content_gauges_count_all_the_water_on_the_line() {
 /// free surface the gauges read (checked against the particles and the volume above).
 #[test]
 fn pressure_probes_read_the_hydrostatic_pressure() {
-    let t = settled_tank();
-    let heights = &t.reading.heights;
-    let surface = heights.iter().sum::<f64>() / heights.len() as f64;
-    let ratio = |probe: &PressureProbe, p: f64| p / (RHO0 * G * (surface - probe.position[1]));
-    let named: Vec<f64> = (t.probes.pressure.iter().zip(&t.reading.pressures))
-        .map(|(probe, &p)| ratio(probe, p))
-        .collect();
-    let (probes, pressures) = &t.random;
-    let random: Vec<f64> = (probes.iter().zip(pressures))
-        .map(|(probe, &p)| ratio(probe, p))
-        .collect();
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
-    let deviation = |v: &[f64]| {
-        let m = mean(v);
-        (v.iter().map(|r| (r - m) * (r - m)).sum::<f64>() / v.len() as f64).sqrt()
-    };
-    let (m, sd) = (mean(&random), deviation(&random));
-    let range =
-        (random.iter().copied()).fold((f64::MAX, f64::MIN), |(lo, hi), r| (lo.min(r), hi.max(r)));
-    let report = format!(
-        "named probes {named:.3?}; 200 random points: mean {m:.3}, standard deviation {sd:.3}, \
+    for walls in WALLS {
+        let t = settled_tank(walls);
+        let heights = &t.reading.heights;
+        let surface = heights.iter().sum::<f64>() / heights.len() as f64;
+        let ratio = |probe: &PressureProbe, p: f64| p / (RHO0 * G * (surface - probe.position[1]));
+        let named: Vec<f64> = (t.probes.pressure.iter().zip(&t.reading.pressures))
+            .map(|(probe, &p)| ratio(probe, p))
+            .collect();
+        let (probes, pressures) = &t.random;
+        let random: Vec<f64> = (probes.iter().zip(pressures))
+            .map(|(probe, &p)| ratio(probe, p))
+            .collect();
+        let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len() as f64;
+        let deviation = |v: &[f64]| {
+            let m = mean(v);
+            (v.iter().map(|r| (r - m) * (r - m)).sum::<f64>() / v.len() as f64).sqrt()
+        };
+        let (m, sd) = (mean(&random), deviation(&random));
+        let range = (random.iter().copied())
+            .fold((f64::MAX, f64::MIN), |(lo, hi), r| (lo.min(r), hi.max(r)));
+        let report = format!(
+            "{walls:?} walls: named probes {named:.3?}; 200 random points: mean {m:.3}, standard deviation {sd:.3}, \
          extremes {:.3} and {:.3}",
-        range.0, range.1
-    );
-    // The particle pressures vary with the packing, so a point reads ρ0·g·depth only to
-    // within a few per cent (docs/method.md §10.3); their mean reads it closely.
-    assert!((m - 1.0).abs() <= 0.03, "{report}");
-    assert!(sd <= 0.05, "{report}");
-    assert!(named.iter().all(|r| (r - 1.0).abs() <= 0.05), "{report}");
-    assert!(random.iter().all(|r| (r - 1.0).abs() <= 0.1), "{report}");
+            range.0, range.1
+        );
+        // The particle pressures vary with the packing, so a point reads ρ0·g·depth only to
+        // within a few per cent (docs/method.md §10.3); their mean reads it closely.
+        assert!((m - 1.0).abs() <= 0.03, "{report}");
+        assert!(sd <= 0.05, "{report}");
+        assert!(named.iter().all(|r| (r - 1.0).abs() <= 0.05), "{report}");
+        assert!(random.iter().all(|r| (r - 1.0).abs() <= 0.1), "{report}");
+    }
 }
 
 /// A 6 × 4 × 6 lattice at rest in a half-metre box, before its first step.

@@ -1,8 +1,8 @@
 //! The built-in scenes (also shipped as `scenes/NAME.json`).
 
 use super::{
-    BodyShape, BoxSpec, ContainerSpec, FluidBlock, MeshSource, MotionSpec, ObstacleSpec,
-    OutputSpec, Scene, SceneBody,
+    BodyShape, BoxSpec, ContainerSpec, ContainerWalls, FluidBlock, MeshSource, MotionSpec,
+    ObstacleSpec, OutputSpec, Scene, SceneBody,
 };
 use crate::body::BodyKind;
 use crate::boundary::Transform;
@@ -215,6 +215,7 @@ fn dam_break(
         containers: vec![ContainerSpec {
             min: [-0.00625; 3],
             max,
+            walls: ContainerWalls::Field,
             layers: 1,
             spacing: None,
         }],

@@ -2,11 +2,11 @@
 
 use super::obstacle;
 use crate::Error;
-use crate::boundary::Transform;
+use crate::boundary::{ContainerWalls, Transform};
 use serde::{Deserialize, Serialize};
 use std::path::PathBuf;
 
-/// A closed box container whose six walls are sampled with boundary particles.
+/// A closed box container: six walls, each a field or sampled with boundary particles.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ContainerSpec {
@@ -14,11 +14,15 @@ pub struct ContainerSpec {
     pub min: [f64; 3],
     /// Upper corner of the walls (m).
     pub max: [f64; 3],
-    /// Wall thickness in layers of boundary particles (1–3; default 1).
+    /// What the walls are (default: fields).
+    #[serde(default)]
+    pub walls: ContainerWalls,
+    /// Wall thickness in layers of boundary particles (1–3; default 1); walls that are
+    /// fields stand for one layer.
     #[serde(default = "one")]
     pub layers: usize,
     /// Largest distance between the walls' boundary particles (m), from r/4 to 2r; `None`
-    /// (the key left out) samples them r apart (docs/method.md §7).
+    /// (the key left out) samples them r apart (docs/method.md §7). Particle walls only.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub spacing: Option<f64>,
 }

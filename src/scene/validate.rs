@@ -1,6 +1,6 @@
 //! Checks of a [`Scene`]'s values; errors name the JSON key and the value.
 
-use super::{ContainerSpec, FluidBlock, ObstacleSpec, Scene};
+use super::{ContainerSpec, ContainerWalls, FluidBlock, ObstacleSpec, Scene};
 use crate::Error;
 use crate::body::Shape;
 use crate::boundary::{MAX_WALL_SPACING, MIN_WALL_SPACING, wall_spacing};
@@ -211,6 +211,20 @@ fn check_container(i: usize, c: &ContainerSpec, r: f64) -> Result<(), Error> {
             c.layers,
             "must be 1, 2 or 3",
         ));
+    }
+    if c.walls == ContainerWalls::Field {
+        let particles = "applies to walls of particles (\"walls\": \"particles\")";
+        if c.layers != 1 {
+            let why = format!("{particles}; walls that are fields stand for one layer");
+            return Err(Error::invalid(format!("{field}.layers"), c.layers, &why));
+        }
+        if let Some(spacing) = c.spacing {
+            return Err(Error::invalid(
+                format!("{field}.spacing"),
+                spacing,
+                particles,
+            ));
+        }
     }
     if let Some(spacing) = c.spacing.filter(|&s| wall_spacing(s, r).is_none()) {
         return Err(Error::invalid(

@@ -5,8 +5,8 @@
 use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
 use crate::boundary::{
-    Aabb, MAX_WALL_SPACING, MIN_WALL_SPACING, WALL_SPACING, WALLS, sample_box_walls_into,
-    wall_spacing,
+    Aabb, ContainerWalls, MAX_WALL_SPACING, MIN_WALL_SPACING, WALL_SPACING, WALLS, WallField,
+    sample_box_walls_into, wall_spacing,
 };
 use crate::{Error, Vec3};
 
@@ -150,7 +150,7 @@ impl World {
         layers: usize,
         spacing: f64,
     ) -> Result<(), Error> {
-        check_finite("container", &[container.min, container.max])?;
+        self.check_container(&container)?;
         let r = self.params.particle_radius;
         let Some(spacing) = wall_spacing(spacing, r) else {
             return Err(Error::invalid(
@@ -163,28 +163,10 @@ impl World {
                 ),
             ));
         };
-        let size = container.max - container.min;
-        if (0..3).any(|a| size[a] < 2.0 * self.params.spacing()) {
-            return Err(Error::invalid(
-                "container",
-                format!(
-                    "{:?}..{:?}",
-                    container.min.as_slice(),
-                    container.max.as_slice()
-                ),
-                "must be at least two particle spacings wide along every axis",
-            ));
-        }
         if !(1..=3).contains(&layers) {
             return Err(Error::invalid("layers", layers, "must be 1, 2 or 3"));
         }
-        if size.iter().any(|&s| s / r > 1e5) {
-            return Err(Error::invalid(
-                "container",
-                format!("{:?}", size.as_slice()),
-                "is too large for the particle radius",
-            ));
-        }
+        let size = container.max - container.min;
         let expected = box_wall_sample_count(&container, spacing, layers);
         if expected + self.boundary.len() as f64 > MAX_PARTICLES as f64 {
             return Err(Error::invalid(
@@ -199,14 +181,75 @@ impl World {
             .map_err(boundary_oom)?;
         sample_box_walls_into(&container, spacing, layers, &mut samples);
         self.containers.try_reserve(1).map_err(boundary_oom)?;
-        if std::env::var_os("PF_FIELD").is_some() {
-            let k = self.constraint.kernel;
-            let rho0 = self.params.rest_density;
-            self.boundary.walls.push(crate::boundary::WallField::new(container, spacing, &k, rho0));
-        } else {
         self.add_boundary_particles(&samples)?;
-        }
         self.containers.push(container);
+        Ok(())
+    }
+
+    /// Adds a closed container box whose six walls are fields rather than particles
+    /// (docs/method.md §7): each wall adds to a fluid particle's density, smoothly, what a
+    /// wall of boundary particles r apart adds on average along it, and costs nothing per
+    /// boundary particle. Fluid outside every container counts as escaped. Errors, changing
+    /// nothing, on a box that is not finite, narrower than two particle spacings along an
+    /// axis or wider than 10⁵·r, or on a shortage of memory.
+    pub fn add_container_field(&mut self, container: Aabb) -> Result<(), Error> {
+        self.check_container(&container)?;
+        let oom = |_| Error::out_of_memory("the container");
+        self.containers.try_reserve(1).map_err(oom)?;
+        self.boundary.walls.try_reserve(1).map_err(oom)?;
+        self.boundary.walls.push(self.wall_field(container));
+        self.containers.push(container);
+        Ok(())
+    }
+
+    /// Adds a closed container box with walls of the kind asked for: fields
+    /// ([`add_container_field`](Self::add_container_field)) or one layer of particles r apart
+    /// ([`add_container`](Self::add_container)). Errors, changing nothing, as those do.
+    pub fn add_container_with(
+        &mut self,
+        container: Aabb,
+        walls: ContainerWalls,
+    ) -> Result<(), Error> {
+        match walls {
+            ContainerWalls::Field => self.add_container_field(container),
+            ContainerWalls::Particles => self.add_container(container, 1),
+        }
+    }
+
+    /// The walls of `container` (m) as a field for this world's fluid.
+    pub(super) fn wall_field(&self, container: Aabb) -> WallField {
+        let spacing = WALL_SPACING * self.params.particle_radius;
+        WallField::new(
+            container,
+            spacing,
+            &self.constraint.kernel,
+            self.params.rest_density,
+        )
+    }
+
+    /// Refuses a container box that is not finite, is narrower than two particle spacings
+    /// along an axis, or is wider than 10⁵·r.
+    pub(super) fn check_container(&self, container: &Aabb) -> Result<(), Error> {
+        check_finite("container", &[container.min, container.max])?;
+        let size = container.max - container.min;
+        if (0..3).any(|a| size[a] < 2.0 * self.params.spacing()) {
+            return Err(Error::invalid(
+                "container",
+                format!(
+                    "{:?}..{:?}",
+                    container.min.as_slice(),
+                    container.max.as_slice()
+                ),
+                "must be at least two particle spacings wide along every axis",
+            ));
+        }
+        if size.iter().any(|&s| s / self.params.particle_radius > 1e5) {
+            return Err(Error::invalid(
+                "container",
+                format!("{:?}", size.as_slice()),
+                "is too large for the particle radius",
+            ));
+        }
         Ok(())
     }
 

@@ -51,6 +51,9 @@ pub struct WorldState {
     pub boundary_sorted: bool,
     /// Container boxes (m).
     pub containers: Vec<Aabb>,
+    /// The containers whose walls are fields rather than particles (m), each also one of
+    /// `containers` (docs/method.md §7).
+    pub field_walls: Vec<Aabb>,
     /// Sink boxes (m).
     pub sinks: Vec<Aabb>,
     /// The domain (m), if one is set.
@@ -97,6 +100,7 @@ impl World {
             bodies: self.bodies.iter().map(|b| b.state()).collect(),
             boundary_sorted: !self.boundary.dirty,
             containers: self.containers.clone(),
+            field_walls: self.boundary.walls.iter().map(|w| *w.container()).collect(),
             sinks: self.sinks.clone(),
             domain: self.domain,
             emitters: self.emitters.iter().map(|e| *e.state()).collect(),
@@ -163,6 +167,15 @@ impl World {
                 ),
             ));
         }
+        for (k, walls) in state.field_walls.iter().enumerate() {
+            self.check_container(walls)
+                .map_err(|e| renamed(e, "container", &format!("state.field_walls[{k}]")))?;
+        }
+        let mut fields = Vec::new();
+        fields
+            .try_reserve_exact(state.field_walls.len())
+            .map_err(|_| Error::out_of_memory("the container walls"))?;
+        fields.extend(state.field_walls.iter().map(|&c| self.wall_field(c)));
         let static_body = |o: u32| self.bodies.get(o as usize).is_some_and(|b| !b.moves());
         if let Some(o) = state
             .boundary_owners
@@ -233,6 +246,7 @@ impl World {
         fluid.next_id = state.next_id;
         fluid.removed = state.removed_count;
         self.boundary = boundary;
+        self.boundary.walls = fields;
         for (body, b) in self.bodies.iter_mut().zip(&state.bodies) {
             body.set_state(b);
         }

@@ -4,6 +4,7 @@
 
 use crate::{Failure, solver_parser};
 use clap::{Args, Subcommand};
+use projfluid::scene::ContainerWalls;
 use projfluid::{Error, SolverKind};
 use projfluid_lab::validation::reference::Measurements;
 use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce};
@@ -33,9 +34,23 @@ pub(crate) struct CommonArgs {
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N", default_value_t = 0)]
     threads: usize,
+    /// What the tank's walls are: `field` (smooth, no particles) or `particles` (one layer r
+    /// apart).
+    #[arg(long, value_name = "KIND", default_value = "field", value_parser = ["field", "particles"])]
+    walls: String,
     /// Directory for the CSV and PNG files, created if missing.
     #[arg(long, value_name = "DIR", default_value = "validation")]
     out: PathBuf,
+}
+
+impl CommonArgs {
+    /// The walls `--walls` names.
+    fn walls(&self) -> ContainerWalls {
+        match self.walls.as_str() {
+            "particles" => ContainerWalls::Particles,
+            _ => ContainerWalls::Field,
+        }
+    }
 }
 
 /// Options of `projfluid validate martin-moyce`.
@@ -192,6 +207,7 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
     setup.layers = args.layers;
     setup.solver = args.common.solver;
     setup.threads = args.common.threads;
+    setup.walls = args.common.walls();
     if let Some(d) = args.duration {
         setup.duration = d;
     }
@@ -265,6 +281,7 @@ fn kleefsman(args: &KleefsmanArgs) -> Result<(), Failure> {
         tolerance: args.tau,
         solver: args.common.solver,
         threads: args.common.threads,
+        walls: args.common.walls(),
     };
     setup.validate().map_err(option_error)?;
     let data = kleefsman::Measurements::load().map_err(runtime)?;
@@ -327,6 +344,7 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
     let mut setup = hydrostatic::Setup {
         solver: args.common.solver,
         threads: args.common.threads,
+        walls: args.common.walls(),
         relax: args.relax,
         damping: args.damping,
         settle: args.settle,

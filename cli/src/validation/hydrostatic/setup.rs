@@ -2,6 +2,7 @@
 //! world they build.
 
 use projfluid::boundary::Aabb;
+use projfluid::scene::ContainerWalls;
 use projfluid::{Error, Params, SolverKind, Vec3, World};
 
 /// How the tank is set up, how it is brought to its equilibrium and how long it then runs
@@ -30,6 +31,8 @@ pub struct Setup {
     pub reading_tolerance: Option<f64>,
     /// Worker threads (0 = one per core).
     pub threads: usize,
+    /// What the tank's walls are (default: fields, as in scenes).
+    pub walls: ContainerWalls,
 }
 
 impl Default for Setup {
@@ -47,6 +50,7 @@ impl Default for Setup {
             tolerance: None,
             reading_tolerance: None,
             threads: 0,
+            walls: ContainerWalls::Field,
         }
     }
 }
@@ -124,7 +128,7 @@ impl Setup {
                 extent(self.count[2]),
             ),
         };
-        world.add_container(tank, 1)?;
+        world.add_container_with(tank, self.walls)?;
         world.add_fluid_block(Vec3::repeat(gap), self.count, Vec3::zeros())?;
         Ok((world, tank))
     }

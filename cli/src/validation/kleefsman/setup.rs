@@ -7,7 +7,9 @@ use super::{
 use projfluid::body::Shape;
 use projfluid::boundary::Transform;
 use projfluid::probe::{Gauge, GaugeMeasure, ProbeSet};
-use projfluid::scene::{ContainerSpec, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene};
+use projfluid::scene::{
+    ContainerSpec, ContainerWalls, FluidBlock, MeshSource, ObstacleSpec, OutputSpec, Scene,
+};
 use projfluid::{Error, Params, SolverKind, Vec3};
 
 /// Name of the default scene, shipped as `scenes/kleefsman_obstacle.json`.
@@ -36,6 +38,8 @@ pub struct Setup {
     pub solver: SolverKind,
     /// Worker threads (0 = one per core).
     pub threads: usize,
+    /// What the tank's walls are (default: fields, as in scenes).
+    pub walls: ContainerWalls,
 }
 
 impl Default for Setup {
@@ -52,6 +56,7 @@ impl Default for Setup {
             tolerance: None,
             solver: defaults.solver,
             threads: 0,
+            walls: ContainerWalls::Field,
         }
     }
 }
@@ -137,6 +142,7 @@ impl Setup {
         let container = ContainerSpec {
             min: [-wall; 3],
             max: world_point(TANK.map(|l| tidy(l + wall))),
+            walls: self.walls,
             layers: 1,
             spacing: None,
         };

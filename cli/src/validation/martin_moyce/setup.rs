@@ -3,6 +3,7 @@
 
 use crate::validation::reference::COLUMN_WIDTH;
 use projfluid::boundary::Aabb;
+use projfluid::scene::ContainerWalls;
 use projfluid::{Error, Params, SolverKind, Vec3, World};
 
 /// How the collapse is set up and how long it runs.
@@ -20,6 +21,8 @@ pub struct Setup {
     pub solver: SolverKind,
     /// Worker threads (0 = one per core).
     pub threads: usize,
+    /// What the tank's walls are (default: fields, as in scenes).
+    pub walls: ContainerWalls,
 }
 
 impl Setup {
@@ -33,6 +36,7 @@ impl Setup {
             duration: if n2 == 1 { 3.5 } else { 3.0 },
             solver: SolverKind::Chebyshev,
             threads: 0,
+            walls: ContainerWalls::Field,
         }
     }
 
@@ -110,7 +114,7 @@ impl Setup {
                 2.0 * gap + (self.layers - 1) as f64 * d,
             ),
         };
-        world.add_container(tank, 1)?;
+        world.add_container_with(tank, self.walls)?;
         world.add_fluid_block(Vec3::repeat(gap), count, Vec3::zeros())?;
         Ok((world, tank))
     }

@@ -626,6 +626,24 @@ enum PfStatus pf_world_add_container_box_spaced(struct PfWorld *world,
                                                 float spacing);
 
 /**
+ * Adds a closed box container from corner `min` to corner `max` (each 3 floats, m) whose
+ * six walls are fields rather than particles (docs/method.md §7): each adds to a fluid
+ * particle's density, smoothly, what a wall of boundary particles r apart adds on average
+ * along it, and costs nothing per boundary particle. This is what scene files use unless
+ * they ask for particles. Fluid farther than r/2 outside every container counts as escaped.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
+ * shorter than two particle spacings or inverted, a side longer than 10⁵·r),
+ * `PF_ERROR_OUT_OF_MEMORY`. On any error the world is unchanged.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable floats.
+ */
+enum PfStatus pf_world_add_container_field(struct PfWorld *world,
+                                           const float *min,
+                                           const float *max);
+
+/**
  * Adds an emitter with a disc-shaped opening of `radius` (m) centred on `position`
  * (3 doubles, m), in the plane normal to `direction` (3 doubles, any non-zero length), and
  * stores its index in `*out_id`. From the start of the next step it inserts fluid

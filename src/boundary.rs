@@ -16,7 +16,7 @@ pub mod transform;
 mod undo;
 pub mod winding;
 
-pub use field::{WallContribution, WallField};
+pub use field::{SHORT_MOVE, WallContribution, WallField};
 pub(crate) use particles::Boundary;
 pub use transform::Transform;
 pub(crate) use undo::BoundaryCopy;

@@ -38,6 +38,10 @@ REJECTED: list[tuple[Callable[[projfluid.World], Any], str]] = [
         "pf_world_add_container_box_spaced: spacing must be from r/4 to 2r",
     ),
     (
+        lambda w: w.add_container_box((0, 0, 0), (0.5, math.nan, 0.5), walls="field"),
+        "pf_world_add_container_field: max must be finite",
+    ),
+    (
         lambda w: w.add_mesh([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 3]]),
         "pf_world_add_mesh: triangles[0][2] must be a vertex index below the vertex count 3, got 3",
     ),

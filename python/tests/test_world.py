@@ -91,6 +91,25 @@ def test_container_walls_take_the_spacing_asked_for() -> None:
     assert 3.5 <= counts[0] / counts[1] <= 4.5
 
 
+def test_container_walls_that_are_fields_hold_the_water_without_particles() -> None:
+    with projfluid.World(projfluid.Params()) as world:
+        world.add_container_box((0, 0, 0), (0.3, 0.4, 0.3), walls="field")
+        world.add_fluid_box((0.05, 0.1, 0.05), (5, 4, 5))
+        assert world.boundary_count == 0
+        stats = world.advance(0.3)
+        xyz = world.positions()
+        assert stats.escaped_count == 0
+        assert (xyz > 0).all() and (xyz[:, 1] > 0.01).all()
+        assert (xyz[:, [0, 2]] < 0.3).all()
+        for bad in (
+            {"walls": "field", "layers": 2},
+            {"walls": "field", "spacing": 0.05},
+            {"walls": "glass"},
+        ):
+            with pytest.raises(ValueError):
+                world.add_container_box((0, 0, 0), (0.3, 0.4, 0.3), **bad)
+
+
 def test_inputs_accept_any_array_like_and_are_rounded_to_float32() -> None:
     with projfluid.World(small_params()) as world:
         world.add_container_box([0, 0, 0], np.array([0.5, 0.4, 0.3]))

@@ -153,6 +153,7 @@ fn fountain() -> Scene {
             4.0,
         )
     };
+    scene.containers[0].walls = ContainerWalls::Particles;
     scene.containers[0].layers = 2;
     scene
 }

@@ -253,6 +253,15 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 1, 0.0f));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 1, 0.06f));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_box_spaced(w, lo, hi, 0, 0.025f));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_field(NULL, lo, hi));
+    REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_container_field(w, lo, NULL));
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_field(w, lo, nan3));
+    CHECK(strstr(last_msg, "max must be finite") != NULL);
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_field(w, hi, lo)); /* inverted */
+    CHECK(strstr(last_msg, "two particle spacings") != NULL);
+    const float farther[3] = {5000.0f, 1.0f, 1.0f}; /* 2e5 radii */
+    REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_container_field(w, lo, farther));
+    CHECK(strstr(last_msg, "too large") != NULL);
 
     /* Bad meshes: zero and absurd counts, bad indices and vertices, degenerate triangles,
      * a mesh far too large for the particle radius. */

@@ -148,6 +148,7 @@ SIGNATURES: dict[str, tuple[list[Any], Any]] = {
     "pf_world_add_boundary_particles": ([_world, _floats, c_size_t], _status),
     "pf_world_add_container_box": ([_world, _floats, _floats, c_uint], _status),
     "pf_world_add_container_box_spaced": ([_world, _floats, _floats, c_uint, c_float], _status),
+    "pf_world_add_container_field": ([_world, _floats, _floats], _status),
     "pf_world_add_mesh": ([_world, _floats, c_size_t, _u32s, c_size_t], _status),
     "pf_world_add_mesh_transformed": (
         [_world, _floats, c_size_t, _u32s, c_size_t, _transform],

@@ -151,15 +151,29 @@ class World(BodiesMixin, FlowMixin):
         self._call(lib.pf_world_add_boundary_particles, _arrays.pointer(xyz, c_float), len(xyz))
 
     def add_container_box(
-        self, min: Vector3, max: Vector3, layers: int = 1, spacing: float | None = None
+        self,
+        min: Vector3,
+        max: Vector3,
+        layers: int = 1,
+        spacing: float | None = None,
+        walls: str = "particles",
     ) -> None:
-        """Adds a closed box from corner ``min`` to corner ``max`` (m) whose walls are
-        ``layers`` (1–3) layers of boundary particles growing outward, at most ``spacing``
-        (m, from r/4 to 2r; None: r) apart."""
+        """Adds a closed box from corner ``min`` to corner ``max`` (m). With ``walls`` =
+        "particles" its walls are ``layers`` (1–3) layers of boundary particles growing
+        outward, at most ``spacing`` (m, from r/4 to 2r; None: r) apart; with "field" each
+        wall is a smooth field that adds what such a wall adds on average, with no particles
+        (as scene files have it unless they ask for particles; ``layers`` 1 and ``spacing``
+        None only)."""
+        if walls not in ("particles", "field"):
+            raise ValueError(f'walls must be "particles" or "field", got {walls!r}')
         if layers < 0:
             raise ValueError(f"layers must not be negative, got {layers}")
         corners = (_arrays.floats3(min, "min"), _arrays.floats3(max, "max"))
-        if spacing is None:
+        if walls == "field":
+            if layers != 1 or spacing is not None:
+                raise ValueError("layers and spacing apply to walls of particles")
+            self._call(lib.pf_world_add_container_field, *corners)
+        elif spacing is None:
             self._call(lib.pf_world_add_container_box, *corners, int(layers))
         else:
             spaced = lib.pf_world_add_container_box_spaced

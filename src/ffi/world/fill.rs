@@ -242,6 +242,35 @@ pub unsafe extern "C" fn pf_world_add_container_box_spaced(
     unsafe { add_container_box(name, world, min, max, layers, spacing) }
 }
 
+/// Adds a closed box container from corner `min` to corner `max` (each 3 floats, m) whose
+/// six walls are fields rather than particles (docs/method.md §7): each adds to a fluid
+/// particle's density, smoothly, what a wall of boundary particles r apart adds on average
+/// along it, and costs nothing per boundary particle. This is what scene files use unless
+/// they ask for particles. Fluid farther than r/2 outside every container counts as escaped.
+///
+/// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
+/// shorter than two particle spacings or inverted, a side longer than 10⁵·r),
+/// `PF_ERROR_OUT_OF_MEMORY`. On any error the world is unchanged.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `min` and `max` must be NULL or point to 3 readable floats.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_add_container_field(
+    world: *mut PfWorld,
+    min: *const f32,
+    max: *const f32,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_add_container_field", || {
+        let mut world = args.world(world)?;
+        let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
+        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
+        world.add_container_field(Aabb { min, max })?;
+        Ok(())
+    })
+}
+
 /// The body of both container calls: the box with the default wall spacing, or `spacing`
 /// (m). Reports errors as `name`.
 ///

@@ -440,19 +440,48 @@ mod tests {
         );
         let text = GOOD.replace(
             "\"max\": [1, 3, 1]",
-            "\"max\": [1, 3, 1], \"spacing\": 0.11",
+            "\"max\": [1, 3, 1], \"walls\": \"particles\", \"spacing\": 0.11",
         );
         assert_eq!(
             message(Scene::from_json(&text)),
             "container[0].spacing must be from r/4 to 2r (0.0125 to 0.1 m), got 0.11"
         );
+        // Walls that are fields take neither layers nor a spacing, and no unknown kind.
+        for (extra, expected) in [
+            (
+                "\"layers\": 2",
+                "container[0].layers applies to walls of particles (\"walls\": \"particles\"); \
+                 walls that are fields stand for one layer, got 2",
+            ),
+            (
+                "\"spacing\": 0.05",
+                "container[0].spacing applies to walls of particles (\"walls\": \"particles\"), \
+                 got 0.05",
+            ),
+        ] {
+            let text = GOOD.replace(
+                "\"max\": [1, 3, 1]",
+                &format!("\"max\": [1, 3, 1], {extra}"),
+            );
+            assert_eq!(message(Scene::from_json(&text)), expected);
+        }
+        let text = GOOD.replace(
+            "\"max\": [1, 3, 1]",
+            "\"max\": [1, 3, 1], \"walls\": \"glass\"",
+        );
+        assert_names(&message(Scene::from_json(&text)), &["glass"]);
         // A spacing in range is kept, builds walls that sparse, and round-trips.
-        let sparse = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, 3, 1], \"spacing\": 0.1");
+        let particles = "\"max\": [1, 3, 1], \"walls\": \"particles\"";
+        let sparse = GOOD.replace(
+            "\"max\": [1, 3, 1]",
+            &format!("{particles}, \"spacing\": 0.1"),
+        );
         let scene = Scene::from_json(&sparse).unwrap();
         assert_eq!(scene.containers[0].spacing, Some(0.1));
         assert_eq!(Scene::from_json(&scene.to_json()).unwrap(), scene);
         let walls = |scene: &Scene| scene.build_world().unwrap().boundary_count() as f64;
-        let ratio = walls(&Scene::from_json(GOOD).unwrap()) / walls(&scene);
+        let dense = Scene::from_json(&GOOD.replace("\"max\": [1, 3, 1]", particles)).unwrap();
+        let ratio = walls(&dense) / walls(&scene);
         assert!((3.5..=4.5).contains(&ratio), "{ratio}");
         let text = GOOD.replace("\"max\": [1, 3, 1]", "\"max\": [1, -3, 1]");
         assert_names(&message(Scene::from_json(&text)), &["container[0]", "-3"]);

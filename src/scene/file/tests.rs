@@ -10,6 +10,10 @@ fn defaults_come_from_params_with_radius() {
     let scene = Scene::from_json(GOOD).unwrap();
     assert_eq!(scene.params, Params::with_radius(0.05));
     assert_eq!(scene.containers[0].layers, 1);
+    assert_eq!(
+        scene.containers[0].walls,
+        crate::scene::ContainerWalls::Field
+    );
     assert_eq!(scene.fluid_blocks[0].velocity, [0.0; 3]);
     assert_eq!(scene.output, OutputSpec::default());
     assert_eq!(scene.particle_count(), 64 + 12);
@@ -40,7 +44,7 @@ fn every_key_is_read() {
             "name": "all", "description": "every key",
             "particle_radius": 0.02, "rest_density": 998, "mass_factor": 0.9, "stiffness": 1e5,
             "gravity": [0, 0, -9.8],
-            "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "layers": 2}],
+            "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "walls": "particles", "layers": 2}],
             "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2], "velocity": [0, 1, 0]}],
             "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "paper", "gamma": 0.9,
                        "tau": 1e-6, "max_iterations": 50, "min_iterations": 2,
@@ -75,6 +79,10 @@ fn every_key_is_read() {
     );
     assert_eq!((p.viscosity, p.threads), (0.02, 2));
     assert_eq!(s.containers[0].layers, 2);
+    assert_eq!(
+        s.containers[0].walls,
+        crate::scene::ContainerWalls::Particles
+    );
     assert_eq!(s.fluid_blocks[0].velocity, [0.0, 1.0, 0.0]);
     assert_eq!(s.duration, 3.0);
     assert_eq!(s.description, "every key");

@@ -22,7 +22,7 @@ fn main() -> Result<(), projfluid::Error> {
         containers: vec![ContainerSpec {
             min: [0.0; 3],
             max: [1.0, 0.8, 0.5],
-            walls: ContainerWalls::Field,
+            walls: ContainerWalls::Particles,
             layers: 1,
             spacing: None,
         }],

@@ -31,9 +31,9 @@ pub(crate) const WALLS: u32 = u32::MAX;
 pub enum ContainerWalls {
     /// Each wall a smooth field: what a wall of boundary particles r apart adds to the
     /// fluid's density, averaged along the wall, with no particles to search or sum over.
-    #[default]
     Field,
     /// Each wall sampled with boundary particles (`layers`, `spacing`).
+    #[default]
     Particles,
 }
 

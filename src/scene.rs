@@ -245,16 +245,16 @@ mod tests {
         let scene = Scene::from_json(GOOD).unwrap();
         let world = scene.build_world().unwrap();
         assert_eq!(world.fluid_count(), 76);
-        // The container's walls are fields (the default): no boundary particles.
-        assert_eq!(world.boundary_count(), 0);
-        assert_eq!(world.containers().len(), 1);
-        let particles = GOOD.replace(
-            "\"max\": [1, 3, 1]",
-            "\"max\": [1, 3, 1], \"walls\": \"particles\"",
-        );
-        let world = Scene::from_json(&particles).unwrap().build_world().unwrap();
         assert!(world.boundary_count() > 0);
         assert_eq!(world.containers().len(), 1);
+        // Walls that are fields: no boundary particles.
+        let field = GOOD.replace(
+            "\"max\": [1, 3, 1]",
+            "\"max\": [1, 3, 1], \"walls\": \"field\"",
+        );
+        let field = Scene::from_json(&field).unwrap().build_world().unwrap();
+        assert_eq!(field.boundary_count(), 0);
+        assert_eq!(field.containers().len(), 1);
         assert_eq!(world.velocities()[64], Vec3::new(1.0, 0.0, 0.0));
     }
 

@@ -151,9 +151,7 @@ impl WallField {
     /// (`sign` +1 for the box's lower wall, −1 for its upper one). The plane's integral P less
     /// what lies beyond each of the wall's four edges, B = G or P − G, plus, for two edges
     /// that meet, what lies beyond both, which the two B took off twice: B₁·B₂/P, exact for a
-    /// kernel that factorises along the plane (a Gaussian) and for a point on the corner; less
-    /// what the smaller masses next to each edge take, K (summed over the edges, each along
-    /// its whole line).
+    /// kernel that factorises along the plane (a Gaussian) and for a point on the corner.
     #[inline(always)]
     fn wall(&self, axis: usize, z: f64, sign: f64, x: Vec3, kernel: &CubicKernel) -> (f64, Vec3) {
         let (h, c) = (self.support, &self.container);
@@ -163,11 +161,8 @@ impl WallField {
         let p = kernel.plane_integral(depth);
         let p_depth = kernel.plane_integral_slope(depth);
         let others = [(axis + 1) % 3, (axis + 2) % 3];
-        // What lies beyond each edge: B, ∂B/∂depth and ∂B/∂x along the edge's axis; and
-        // what the smaller masses next to each edge take, K.
+        // What lies beyond each edge: B, ∂B/∂depth and ∂B/∂x along the edge's axis.
         let mut beyond = [[Share::default(); 2]; 2];
-        let mut shrink = Share::default();
-        let mut shrink_across = [0.0; 2];
         for (k, &other) in others.iter().enumerate() {
             for (l, (e, s)) in [
                 (x[other] - c.min[other], 1.0),
@@ -176,13 +171,6 @@ impl WallField {
             .into_iter()
             .enumerate()
             {
-                if e >= 2.0 * h {
-                    continue;
-                }
-                let t = table.shrink(depth * inverse, e * inverse);
-                shrink.value += t.g * inverse;
-                shrink.depth += t.g_z * inverse * inverse;
-                shrink_across[k] += t.g_c * inverse * inverse * s;
                 if e >= h {
                     continue;
                 }
@@ -207,11 +195,9 @@ impl WallField {
                 };
             }
         }
-        let mut density = p - shrink.value;
-        let mut d_depth = p_depth - shrink.depth;
+        let mut density = p;
+        let mut d_depth = p_depth;
         let mut gradient = Vec3::zeros();
-        gradient[others[0]] -= shrink_across[0];
-        gradient[others[1]] -= shrink_across[1];
         for (k, &other) in others.iter().enumerate() {
             for b in &beyond[k] {
                 density -= b.value;
@@ -360,12 +346,16 @@ mod tests {
         let short = SHORT_MOVE * kernel.support_radius();
         let mut needed: f64 = 0.0;
         for _ in 0..20_000 {
-            // Near the corner, some points outside the box (a particle pushed through).
-            let x = Vec3::new(
+            // Near the lower corner, or (every other point) the upper one, some points outside
+            // the box (a particle pushed through).
+            let mut x = Vec3::new(
                 0.06 + coordinate(0.16),
                 0.06 + coordinate(0.16),
                 0.06 + coordinate(0.16),
             );
+            if coordinate(1.0) > 0.0 {
+                x = Vec3::repeat(1.0) - x;
+            }
             let mut delta = Vec3::new(coordinate(1.0), coordinate(1.0), coordinate(1.0));
             delta *= short * rng_fraction(&mut coordinate) / delta.norm();
             let here = field.at(x, &kernel);

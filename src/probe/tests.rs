@@ -250,7 +250,7 @@ fn content_gauges_count_all_the_water_on_the_line() {
 /// in the fluid and on the walls, and so do 200 random points of the same region on average
 /// (each within 10 %, their standard deviation at most 5 %); the depth is measured from the
 /// free surface the gauges read (checked against the particles and the volume above). In a
-/// tank whose walls are fields, within 8 % and 12 %, the mean within 5 % (see below).
+/// tank whose walls are fields, within 10 % and 12 %, the mean within 5 % (see below).
 #[test]
 fn pressure_probes_read_the_hydrostatic_pressure() {
     for walls in WALLS {
@@ -282,10 +282,10 @@ fn pressure_probes_read_the_hydrostatic_pressure() {
         // within a few per cent (docs/method.md §10.3); their mean reads it closely. Next to
         // smooth walls the water packs otherwise and its particle pressures read about 4 %
         // high (as next to walls sampled at 2r): there the mean must lie within 5 %, a named
-        // point within 8 % and each random point within 12 %.
+        // point within 10 % and each random point within 12 %.
         let (within, named_within, each_within) = match walls {
             ContainerWalls::Particles => (0.03, 0.05, 0.1),
-            ContainerWalls::Field => (0.05, 0.08, 0.12),
+            ContainerWalls::Field => (0.05, 0.1, 0.12),
         };
         assert!((m - 1.0).abs() <= within, "{report}");
         assert!(sd <= 0.05, "{report}");

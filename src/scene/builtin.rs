@@ -153,7 +153,6 @@ fn fountain() -> Scene {
             4.0,
         )
     };
-    scene.containers[0].walls = ContainerWalls::Particles;
     scene.containers[0].layers = 2;
     scene
 }
@@ -216,7 +215,7 @@ fn dam_break(
         containers: vec![ContainerSpec {
             min: [-0.00625; 3],
             max,
-            walls: ContainerWalls::Field,
+            walls: ContainerWalls::Particles,
             layers: 1,
             spacing: None,
         }],

@@ -14,7 +14,7 @@ pub struct ContainerSpec {
     pub min: [f64; 3],
     /// Upper corner of the walls (m).
     pub max: [f64; 3],
-    /// What the walls are (default: fields).
+    /// What the walls are (default: particles).
     #[serde(default)]
     pub walls: ContainerWalls,
     /// Wall thickness in layers of boundary particles (1–3; default 1); walls that are

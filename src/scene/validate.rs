@@ -449,12 +449,12 @@ mod tests {
         // Walls that are fields take neither layers nor a spacing, and no unknown kind.
         for (extra, expected) in [
             (
-                "\"layers\": 2",
+                "\"walls\": \"field\", \"layers\": 2",
                 "container[0].layers applies to walls of particles (\"walls\": \"particles\"); \
                  walls that are fields stand for one layer, got 2",
             ),
             (
-                "\"spacing\": 0.05",
+                "\"walls\": \"field\", \"spacing\": 0.05",
                 "container[0].spacing applies to walls of particles (\"walls\": \"particles\"), \
                  got 0.05",
             ),

@@ -776,9 +776,10 @@ fn container_walls_are_sampled_at_the_spacing_asked_for() {
 /// A container whose walls are fields gives the fluid next to it the density walls of
 /// particles give: a block placed 2.25r from every wall, as the built-in scenes place theirs,
 /// reads within 0.1 % of the same block between walls of particles along the walls (where
-/// the field is the particles' average along the wall) and within 1 % in the edges and
-/// corners (where the field's masses shrink as the particles' Akinci masses do), and rest
-/// density in the bulk.
+/// the field is the particles' average along the wall), and rest density in the bulk. In the
+/// edges it reads up to 2 % and in the three-wall corners up to 4.5 % higher, never more
+/// than 1 % above ρ0: the field does not shrink its masses next to the box's edges as the
+/// particles' Akinci masses do (docs/method.md §7).
 #[test]
 fn walls_that_are_fields_give_the_density_walls_of_particles_give() {
     let r = Params::default().particle_radius;
@@ -816,9 +817,14 @@ fn walls_that_are_fields_give_the_density_walls_of_particles_give() {
                 faces += 1;
                 assert!(difference < 1e-3, "face {p:?}: {a} against {b}");
             }
-            _ => {
+            walls => {
                 edges += 1;
-                assert!(difference < 1e-2, "edge {p:?}: {a} against {b}");
+                let bound = if walls == 2 { 2e-2 } else { 4.5e-2 };
+                assert!(
+                    (b - a) / rho0 < bound && b - a > -1e-3 * rho0,
+                    "edge {p:?}: {a} against {b}"
+                );
+                assert!(b / rho0 < 1.01, "edge {p:?}: {b}");
             }
         }
     }

@@ -1,133 +1,41 @@
-//! What a wall's edges change in its plane integral, tabulated once for a kernel of unit
-//! support (docs/method.md §7).
+//! The part of a wall's plane integral that lies beyond one edge of the wall, tabulated once
+//! for a kernel of unit support (docs/method.md §7).
 //!
 //! For a point at distance z from a wall's plane whose foot lies c inside one of the wall's
 //! edges, G(z, c) = ∫_{u > c} ∫ W(√(u² + v² + z²)) dv du, the kernel summed over the half
 //! plane beyond that edge: a wall that ends there adds P(z) − G(z, c) instead of the whole
 //! plane's P(z). With the line integral ℓ(d) = ∫ W(√(d² + s²)) ds,
 //! G = ∫_c^∞ ℓ(√(u² + z²)) du, ∂G/∂c = −ℓ(√(c² + z²)) and ∂G/∂z = ∫_c^∞ ℓ'(ρ)·z/ρ du with
-//! ρ = √(u² + z²).
-//!
-//! Next to an edge a wall's particles also see the other wall's, so their Akinci masses are
-//! smaller (§2.6). For the continuous wall, at a point e inside the edge that sum is
-//! S(e) = P(0) − G(0, e) + P(e)/2 (its own wall cut at the edge, and the other wall, whose
-//! plane lies e away, up to the edge), and the mass per area is that of the open wall times
-//! 1 − δ(e), δ = 1 − P(0)/S(e). What the shrinking takes from a point's density is
-//! K(z, c) = ∫_0^1 δ(e) ℓ(√((e − c)² + z²)) de, tabulated for c from −1 to 2.
-//!
-//! A kernel of support H scales both: G_H(z, c) = G(z/H, c/H)/H, and so K.
+//! ρ = √(u² + z²). A kernel of support H scales them: G_H(z, c) = G(z/H, c/H)/H.
 
 use crate::kernel::CubicKernel;
 use std::sync::OnceLock;
 
-/// Intervals per unit of z and c in the tables of G and K.
+/// Intervals per unit of z and c in the tables of G and ∂G/∂z.
 const STEPS: usize = 64;
 /// Intervals per unit of d in the table of ℓ.
 const LINE_STEPS: usize = 1024;
-/// Simpson panels (an even number) of each integral.
+/// Simpson panels (an even number) of each integral over u.
 const PANELS: usize = 128;
-/// The range of c in the table of K: from −1 (a foot one support beyond the edge) to 2.
-const SHRINK_FROM: f64 = -1.0;
-const SHRINK_TO: f64 = 2.0;
 
-/// A function of (z, c) and its derivatives on a grid, interpolated by bicubic Hermite
-/// polynomials, so that it and its gradient are continuous and the gradient is the
-/// interpolant's own.
-struct HermiteGrid {
-    /// [f, ∂f/∂z, ∂f/∂c, ∂²f/∂z∂c] at each node, row by row in z.
-    nodes: Vec<[f64; 4]>,
-    /// Nodes per row (along c).
-    row: usize,
-    /// The c of the first column.
-    c_from: f64,
-}
-
-impl HermiteGrid {
-    /// The grid over z in [0, 1] and c in [`c_from`, `c_from` + `columns`/[`STEPS`]], with
-    /// `node(z, c)` at each node.
-    fn build(c_from: f64, columns: usize, node: impl Fn(f64, f64) -> [f64; 4]) -> Self {
-        let unit = |k: usize| k as f64 / STEPS as f64;
-        let nodes = (0..=STEPS)
-            .flat_map(|zi| (0..=columns).map(move |ci| (zi, ci)))
-            .map(|(zi, ci)| node(unit(zi), c_from + unit(ci)))
-            .collect();
-        HermiteGrid {
-            nodes,
-            row: columns + 1,
-            c_from,
-        }
-    }
-
-    /// f, ∂f/∂z and ∂f/∂c at (z, c); zero outside the grid.
-    #[inline]
-    fn at(&self, z: f64, c: f64) -> [f64; 3] {
-        let (sz, sc) = (z * STEPS as f64, (c - self.c_from) * STEPS as f64);
-        if !(0.0..STEPS as f64).contains(&sz) || !(0.0..(self.row - 1) as f64).contains(&sc) {
-            return [0.0; 3];
-        }
-        let (zi, ci) = (sz as usize, sc as usize);
-        let (t, u) = (sz - zi as f64, sc - ci as f64);
-        let step = 1.0 / STEPS as f64;
-        // The cubic Hermite basis on [0, 1] and its derivative: values at 0 and 1, then
-        // slopes at 0 and 1.
-        let basis = |t: f64| {
-            let (t2, t3) = (t * t, t * t * t);
-            [
-                2.0 * t3 - 3.0 * t2 + 1.0,
-                -2.0 * t3 + 3.0 * t2,
-                t3 - 2.0 * t2 + t,
-                t3 - t2,
-            ]
-        };
-        let slope = |t: f64| {
-            let t2 = t * t;
-            [
-                6.0 * t2 - 6.0 * t,
-                -6.0 * t2 + 6.0 * t,
-                3.0 * t2 - 4.0 * t + 1.0,
-                3.0 * t2 - 2.0 * t,
-            ]
-        };
-        let (bz, dz, bc, dc) = (basis(t), slope(t), basis(u), slope(u));
-        let (mut f, mut f_z, mut f_c) = (0.0, 0.0, 0.0);
-        for a in 0..2 {
-            for b in 0..2 {
-                let [v, v_z, v_c, v_zc] = self.nodes[(zi + a) * self.row + ci + b];
-                // The node's value and its slopes scaled to the unit cell.
-                let terms = [
-                    (a, b, v),
-                    (a + 2, b, v_z * step),
-                    (a, b + 2, v_c * step),
-                    (a + 2, b + 2, v_zc * step * step),
-                ];
-                for (i, j, w) in terms {
-                    f += bz[i] * bc[j] * w;
-                    f_z += dz[i] * bc[j] * w;
-                    f_c += bz[i] * dc[j] * w;
-                }
-            }
-        }
-        [f, f_z / step, f_c / step]
-    }
-}
-
-/// The tables of G and K, and ℓ and ℓ' on a fine grid of d in [0, 1], for the kernel of
-/// support 1.
+/// G and its derivatives ∂G/∂z, ∂G/∂c and ∂²G/∂z∂c on a grid of (z, c) in [0, 1]², and ℓ and
+/// ℓ' on a fine grid of d in [0, 1], for the kernel of support 1. G is interpolated between
+/// the grid's nodes by bicubic Hermite polynomials, so that it and its gradient are
+/// continuous and the gradient is the interpolant's own.
 pub(super) struct EdgeTable {
-    beyond: HermiteGrid,
-    shrink: HermiteGrid,
+    /// [G, ∂G/∂z, ∂G/∂c, ∂²G/∂z∂c] at each node, row by row in z.
+    nodes: Vec<[f64; 4]>,
     line: Vec<f64>,
     line_slope: Vec<f64>,
 }
 
-/// The table, built on first use (a few tens of milliseconds).
+/// The table, built on first use (a few milliseconds).
 pub(super) fn table() -> &'static EdgeTable {
     static TABLE: OnceLock<EdgeTable> = OnceLock::new();
     TABLE.get_or_init(EdgeTable::build)
 }
 
-/// A function of (z, c) at one point, for the kernel of support 1: its value and its
-/// derivatives along z and c.
+/// What lies beyond one edge, for the kernel of support 1: G, ∂G/∂z and ∂G/∂c.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub(super) struct Beyond {
     pub g: f64,
@@ -149,55 +57,43 @@ impl EdgeTable {
                 (kernel.line_integral(d + e) - kernel.line_integral((d - e).abs())) / (2.0 * e)
             })
             .collect();
-        let empty = || HermiteGrid {
-            nodes: Vec::new(),
-            row: 1,
-            c_from: 0.0,
-        };
         let mut table = EdgeTable {
-            beyond: empty(),
-            shrink: empty(),
+            nodes: Vec::new(),
             line,
             line_slope,
         };
-        table.beyond = HermiteGrid::build(0.0, STEPS, |z, c| {
-            let corner = (z * z + c * c).sqrt();
-            // ∂G/∂c = −ℓ(√(z² + c²)), and its derivative along z.
-            let g_c = -table.line_at(corner);
-            let g_zc = -table.line_slope_at(corner) * ratio(z, corner);
-            let top = (1.0 - z * z).max(0.0).sqrt();
-            if c >= top {
-                return [0.0, 0.0, g_c, g_zc];
+        let unit = |k: usize| k as f64 / STEPS as f64;
+        let mut nodes = Vec::with_capacity((STEPS + 1) * (STEPS + 1));
+        for zi in 0..=STEPS {
+            for ci in 0..=STEPS {
+                let (z, c) = (unit(zi), unit(ci));
+                let corner = (z * z + c * c).sqrt();
+                // ∂G/∂c = −ℓ(√(z² + c²)), and its derivative along z.
+                let g_c = -table.line_at(corner);
+                let g_zc = if corner > 0.0 {
+                    -table.line_slope_at(corner) * z / corner
+                } else {
+                    0.0
+                };
+                let top = (1.0 - z * z).max(0.0).sqrt();
+                if c >= top {
+                    nodes.push([0.0, 0.0, g_c, g_zc]);
+                    continue;
+                }
+                let rho = |u: f64| (u * u + z * z).sqrt();
+                let g = simpson(c, top, |u| table.line_at(rho(u)));
+                let g_z = simpson(c, top, |u| {
+                    let r = rho(u);
+                    if r > 0.0 {
+                        table.line_slope_at(r) * z / r
+                    } else {
+                        0.0
+                    }
+                });
+                nodes.push([g, g_z, g_c, g_zc]);
             }
-            let rho = |u: f64| (u * u + z * z).sqrt();
-            let g = simpson(c, top, |u| table.line_at(rho(u)));
-            let g_z = simpson(c, top, |u| table.line_slope_at(rho(u)) * ratio(z, rho(u)));
-            [g, g_z, g_c, g_zc]
-        });
-        // δ(e) on [0, 1], from G at z = 0 and P.
-        let p = |z: f64| kernel.plane_integral(z);
-        let delta = |e: f64| {
-            let sum = p(0.0) - table.beyond.at(0.0, e)[0] + 0.5 * p(e);
-            1.0 - p(0.0) / sum
-        };
-        let integrals = |z: f64, c: f64| {
-            let rho = |e: f64| ((e - c) * (e - c) + z * z).sqrt();
-            let k = simpson(0.0, 1.0, |e| delta(e) * table.line_at(rho(e)));
-            let k_z = simpson(0.0, 1.0, |e| {
-                delta(e) * table.line_slope_at(rho(e)) * ratio(z, rho(e))
-            });
-            let k_c = simpson(0.0, 1.0, |e| {
-                delta(e) * table.line_slope_at(rho(e)) * ratio(c - e, rho(e))
-            });
-            [k, k_z, k_c]
-        };
-        let columns = ((SHRINK_TO - SHRINK_FROM) * STEPS as f64).round() as usize;
-        table.shrink = HermiteGrid::build(SHRINK_FROM, columns, |z, c| {
-            let [k, k_z, k_c] = integrals(z, c);
-            let h = 1e-4;
-            let k_zc = (integrals(z, c + h)[1] - integrals(z, c - h)[1]) / (2.0 * h);
-            [k, k_z, k_c, k_zc]
-        });
+        }
+        table.nodes = nodes;
         table
     }
 
@@ -231,27 +127,63 @@ impl EdgeTable {
         self.line_slope[k] * (1.0 - t) + self.line_slope[k + 1] * t
     }
 
-    /// G, ∂G/∂z and ∂G/∂c at `z` ≥ 0 and `c` ≥ 0 (both relative to the support); 0 at and
-    /// beyond 1.
+    /// G, ∂G/∂z and ∂G/∂c at `z` ≥ 0 and `c` ≥ 0 (both relative to the support), by bicubic
+    /// Hermite interpolation of the nodes around (z, c); 0 at and beyond 1.
     #[inline]
     pub(super) fn beyond(&self, z: f64, c: f64) -> Beyond {
-        let [g, g_z, g_c] = self.beyond.at(z, c);
-        Beyond { g, g_z, g_c }
+        let (sz, sc) = (z * STEPS as f64, c * STEPS as f64);
+        if sz >= STEPS as f64 || sc >= STEPS as f64 {
+            return Beyond::default();
+        }
+        let (zi, ci) = (sz as usize, sc as usize);
+        let (t, u) = (sz - zi as f64, sc - ci as f64);
+        let step = 1.0 / STEPS as f64;
+        // The cubic Hermite basis on [0, 1] and its derivative: values at 0 and 1, then
+        // slopes at 0 and 1.
+        let basis = |t: f64| {
+            let (t2, t3) = (t * t, t * t * t);
+            [
+                2.0 * t3 - 3.0 * t2 + 1.0,
+                -2.0 * t3 + 3.0 * t2,
+                t3 - 2.0 * t2 + t,
+                t3 - t2,
+            ]
+        };
+        let slope = |t: f64| {
+            let t2 = t * t;
+            [
+                6.0 * t2 - 6.0 * t,
+                -6.0 * t2 + 6.0 * t,
+                3.0 * t2 - 4.0 * t + 1.0,
+                3.0 * t2 - 2.0 * t,
+            ]
+        };
+        let (bz, dz, bc, dc) = (basis(t), slope(t), basis(u), slope(u));
+        let row = STEPS + 1;
+        let (mut g, mut g_z, mut g_c) = (0.0, 0.0, 0.0);
+        for a in 0..2 {
+            for b in 0..2 {
+                let [v, v_z, v_c, v_zc] = self.nodes[(zi + a) * row + ci + b];
+                // The node's value and its slopes scaled to the unit cell.
+                let terms = [
+                    (a, b, v),
+                    (a + 2, b, v_z * step),
+                    (a, b + 2, v_c * step),
+                    (a + 2, b + 2, v_zc * step * step),
+                ];
+                for (i, j, w) in terms {
+                    g += bz[i] * bc[j] * w;
+                    g_z += dz[i] * bc[j] * w;
+                    g_c += bz[i] * dc[j] * w;
+                }
+            }
+        }
+        Beyond {
+            g,
+            g_z: g_z / step,
+            g_c: g_c / step,
+        }
     }
-
-    /// K, ∂K/∂z and ∂K/∂c at `z` ≥ 0 and `c` (both relative to the support): what the smaller
-    /// masses next to an edge take from the density of a point whose foot lies c inside it;
-    /// 0 for c at or beyond 2 and at or below −1.
-    #[inline]
-    pub(super) fn shrink(&self, z: f64, c: f64) -> Beyond {
-        let [g, g_z, g_c] = self.shrink.at(z, c);
-        Beyond { g, g_z, g_c }
-    }
-}
-
-/// a/b, 0 where b is 0.
-fn ratio(a: f64, b: f64) -> f64 {
-    if b > 0.0 { a / b } else { 0.0 }
 }
 
 /// ∫_a^b f by Simpson's rule on [`PANELS`] panels.

@@ -12,7 +12,7 @@ fn defaults_come_from_params_with_radius() {
     assert_eq!(scene.containers[0].layers, 1);
     assert_eq!(
         scene.containers[0].walls,
-        crate::scene::ContainerWalls::Field
+        crate::scene::ContainerWalls::Particles
     );
     assert_eq!(scene.fluid_blocks[0].velocity, [0.0; 3]);
     assert_eq!(scene.output, OutputSpec::default());

@@ -34,9 +34,9 @@ pub(crate) struct CommonArgs {
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N", default_value_t = 0)]
     threads: usize,
-    /// What the tank's walls are: `field` (smooth, no particles) or `particles` (one layer r
-    /// apart).
-    #[arg(long, value_name = "KIND", default_value = "field", value_parser = ["field", "particles"])]
+    /// What the tank's walls are: `particles` (one layer r apart) or `field` (smooth, no
+    /// particles).
+    #[arg(long, value_name = "KIND", default_value = "particles", value_parser = ["particles", "field"])]
     walls: String,
     /// Directory for the CSV and PNG files, created if missing.
     #[arg(long, value_name = "DIR", default_value = "validation")]

@@ -31,7 +31,7 @@ pub struct Setup {
     pub reading_tolerance: Option<f64>,
     /// Worker threads (0 = one per core).
     pub threads: usize,
-    /// What the tank's walls are (default: fields, as in scenes).
+    /// What the tank's walls are (default: particles, as in scenes).
     pub walls: ContainerWalls,
 }
 
@@ -50,7 +50,7 @@ impl Default for Setup {
             tolerance: None,
             reading_tolerance: None,
             threads: 0,
-            walls: ContainerWalls::Field,
+            walls: ContainerWalls::Particles,
         }
     }
 }

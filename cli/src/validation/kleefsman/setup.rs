@@ -38,7 +38,7 @@ pub struct Setup {
     pub solver: SolverKind,
     /// Worker threads (0 = one per core).
     pub threads: usize,
-    /// What the tank's walls are (default: fields, as in scenes).
+    /// What the tank's walls are (default: particles, as in scenes).
     pub walls: ContainerWalls,
 }
 
@@ -56,7 +56,7 @@ impl Default for Setup {
             tolerance: None,
             solver: defaults.solver,
             threads: 0,
-            walls: ContainerWalls::Field,
+            walls: ContainerWalls::Particles,
         }
     }
 }

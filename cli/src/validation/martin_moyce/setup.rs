@@ -21,7 +21,7 @@ pub struct Setup {
     pub solver: SolverKind,
     /// Worker threads (0 = one per core).
     pub threads: usize,
-    /// What the tank's walls are (default: fields, as in scenes).
+    /// What the tank's walls are (default: particles, as in scenes).
     pub walls: ContainerWalls,
 }
 
@@ -36,7 +36,7 @@ impl Setup {
             duration: if n2 == 1 { 3.5 } else { 3.0 },
             solver: SolverKind::Chebyshev,
             threads: 0,
-            walls: ContainerWalls::Field,
+            walls: ContainerWalls::Particles,
         }
     }
 

@@ -237,8 +237,9 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 11] = [
+    let cases: [&[&str]; 12] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
+        &["validate", "hydrostatic", "--walls", "glass", "--out", out_dir],
         &[
             "validate",
             "martin-moyce",
@@ -328,6 +329,8 @@ fn cli_hydrostatic_writes_its_profile_and_chart() {
         "0.1",
         "--settings",
         "default",
+        "--walls",
+        "field",
         "--out",
         dir.to_str().unwrap(),
     ]);

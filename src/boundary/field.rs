@@ -259,6 +259,18 @@ mod tests {
     use super::*;
     use crate::boundary::sample_box_walls;
 
+    /// r (m), ρ0 (kg/m³), the kernel, a 1 m box and its walls as a field.
+    fn unit_box() -> (f64, f64, CubicKernel, Aabb, WallField) {
+        let (r, rho0) = (0.025, 1000.0);
+        let kernel = CubicKernel::new(4.0 * r);
+        let container = Aabb {
+            min: Vec3::zeros(),
+            max: Vec3::repeat(1.0),
+        };
+        let field = WallField::new(container, r, &kernel, rho0);
+        (r, rho0, kernel, container, field)
+    }
+
     /// Far from the box's edges, a wall field adds what the sampled wall it stands for adds,
     /// averaged over where a particle sits along the wall: the density at several distances
     /// from the floor, averaged over a grid of positions across one cell of the sampling,
@@ -266,13 +278,7 @@ mod tests {
     /// its density.
     #[test]
     fn a_wall_field_is_the_sampled_wall_averaged_along_it() {
-        let (r, rho0) = (0.025, 1000.0);
-        let kernel = CubicKernel::new(4.0 * r);
-        let container = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::new(1.0, 1.0, 1.0),
-        };
-        let field = WallField::new(container, r, &kernel, rho0);
+        let (r, rho0, kernel, container, field) = unit_box();
         let all = sample_box_walls(&container, r, 1);
         // The wall particles that reach the points below, with their Akinci volumes.
         let walls: Vec<Vec3> = all
@@ -334,13 +340,7 @@ mod tests {
     /// density there.
     #[test]
     fn the_curvature_bound_majorises_the_change() {
-        let (r, rho0) = (0.025, 1000.0);
-        let kernel = CubicKernel::new(4.0 * r);
-        let container = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::new(1.0, 1.0, 1.0),
-        };
-        let field = WallField::new(container, r, &kernel, rho0);
+        let (r, rho0, kernel, _, field) = unit_box();
         let mut rng = crate::random::SplitMix64(3);
         let mut coordinate = |scale: f64| (rng.next_f64() - 0.5) * scale;
         let short = SHORT_MOVE * kernel.support_radius();
@@ -394,14 +394,8 @@ mod tests {
     /// nowhere larger than twice the steepest slope of a whole plane's.
     #[test]
     fn the_field_stays_smooth_where_a_wall_leaves_reach() {
-        let (r, rho0) = (0.025, 1000.0);
-        let kernel = CubicKernel::new(4.0 * r);
+        let (_, _, kernel, _, field) = unit_box();
         let h = kernel.support_radius();
-        let container = Aabb {
-            min: Vec3::zeros(),
-            max: Vec3::repeat(1.0),
-        };
-        let field = WallField::new(container, r, &kernel, rho0);
         let steepest = (0..=1000)
             .map(|k| kernel.plane_integral_slope(h * k as f64 / 1000.0).abs())
             .fold(0.0, f64::max)

@@ -629,8 +629,10 @@ enum PfStatus pf_world_add_container_box_spaced(struct PfWorld *world,
  * Adds a closed box container from corner `min` to corner `max` (each 3 floats, m) whose
  * six walls are fields rather than particles (docs/method.md §7): each adds to a fluid
  * particle's density, smoothly, what a wall of boundary particles r apart adds on average
- * along it, and costs nothing per boundary particle. This is what scene files use unless
- * they ask for particles. Fluid farther than r/2 outside every container counts as escaped.
+ * along it, and costs nothing per boundary particle: a scene's `"walls": "field"`. It read
+ * pressures about 4 % high in a tank at rest and let one dam break compress 4.2 % where walls
+ * of particles allowed 1.3 % (docs/method.md §7). Fluid farther than r/2 outside every
+ * container counts as escaped.
  *
  * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
  * shorter than two particle spacings or inverted, a side longer than 10⁵·r),

@@ -100,11 +100,7 @@ impl DensityConstraint {
             let (dx, dy, dz) = (rx + shift.x, ry + shift.y, rz + shift.z);
             *w = psi * k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
-        let walls = if scratch.wall.curvature > 0.0 {
-            self.walls_at(scratch.wall_at + shift, nb.walls).density
-        } else {
-            0.0
-        };
+        let walls = self.walls_at(scratch.wall_at + shift, nb.walls).density;
         self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n) + walls
     }
 

@@ -113,8 +113,6 @@ pub struct DensityConstraint {
     pub(crate) evaluate_first_step: bool,
 }
 
-/// The fixture of the stencil and first-step tests: a jittered cluster of fluid particles
-/// over a floor of boundary particles, and the constraint it is tested with.
 impl DensityConstraint {
     /// What the container walls without particles add at `x` (m), summed over them.
     #[inline(always)]
@@ -130,6 +128,8 @@ impl DensityConstraint {
     }
 }
 
+/// The fixture of the stencil and first-step tests: a jittered cluster of fluid particles
+/// over a floor of boundary particles, and the constraint it is tested with.
 #[cfg(test)]
 mod test_cluster {
     use super::*;

@@ -205,9 +205,9 @@ impl WallField {
                 gradient[other] -= b.across;
             }
         }
-        // B₁·B₂/P is ill-conditioned where P and both B vanish together (H away from the
-        // plane, where the interpolated B are not as small as P): P + ε in its place changes
-        // it by at most ε there and nothing where it matters, next to the corner.
+        // B₁·B₂/P is ill-conditioned where P and both B vanish together, H from the plane:
+        // there the interpolated B are not as small as P (tested). P + ε in its place changes
+        // the term by at most ε there and nothing where it matters, next to the corner.
         let q = p + CORNER_REGULARIZATION * kernel.plane_integral(0.0);
         for b1 in &beyond[0] {
             for b2 in &beyond[1] {
@@ -387,6 +387,40 @@ mod tests {
             }
         }
         eprintln!("the largest share of the curvature bound a move needed: {needed}");
+    }
+
+    /// The corner term B₁·B₂/(P + ε) never adds more than the smaller of the two shares it
+    /// corrects for, at any depth up to the reach H and any two distances from the edges:
+    /// near H the interpolated B undershoot or overshoot the vanishing P (|B|/P reaches
+    /// about 1,900 there), and without ε the term exceeds them (by up to 10⁻⁷·P(0): small,
+    /// but a term that should correct a share would outgrow it).
+    #[test]
+    fn the_corner_term_stays_below_the_shares_it_corrects() {
+        let (_, _, kernel, _, _) = unit_box();
+        let h = kernel.support_radius();
+        let table = edge::table();
+        let p0 = kernel.plane_integral(0.0);
+        let (mut ratio, mut excess): (f64, f64) = (0.0, 0.0);
+        for i in 0..4000 {
+            let depth = h * i as f64 / 4000.0;
+            let p = kernel.plane_integral(depth);
+            let b: Vec<f64> = (0..=100)
+                .map(|j| table.beyond(depth / h, j as f64 / 100.0).g / h)
+                .collect();
+            ratio = b.iter().fold(ratio, |r, b| r.max(b.abs() / p));
+            let q = p + CORNER_REGULARIZATION * p0;
+            for (b1, b2) in b.iter().flat_map(|b1| b.iter().map(move |b2| (b1, b2))) {
+                excess = excess.max((b1 * b2).abs() / q - b1.abs().min(b2.abs()));
+            }
+        }
+        assert!(
+            ratio > 1.0,
+            "B within P everywhere ({ratio}): ε is not needed"
+        );
+        assert!(
+            excess <= 1e-12 * p0,
+            "the corner term exceeds a share by {excess}"
+        );
     }
 
     /// In a corner of the box and out to the reach H of its walls, where a wall's share and

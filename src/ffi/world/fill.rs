@@ -50,6 +50,14 @@ fn read_vec3(args: Args, p: *const f32, what: &str) -> Result<Vec3, Failure> {
     Ok(Vec3::new(v[0].into(), v[1].into(), v[2].into()))
 }
 
+/// Reads a container's corners `min` and `max` (3 floats each, m), each finite; the world
+/// checks their order.
+fn read_corners(args: Args, min: *const f32, max: *const f32) -> Result<Aabb, Failure> {
+    let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
+    let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
+    Ok(Aabb { min, max })
+}
+
 /// Rejects a non-finite 3-vector argument, naming it.
 fn check_finite(v: Vec3, what: &str) -> Result<Vec3, Failure> {
     if v.iter().all(|c| c.is_finite()) {
@@ -266,9 +274,7 @@ pub unsafe extern "C" fn pf_world_add_container_field(
     let args = unsafe { Args::trusted() };
     status_call("pf_world_add_container_field", || {
         let mut world = args.world(world)?;
-        let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
-        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
-        world.add_container_field(Aabb { min, max })?;
+        world.add_container_field(read_corners(args, min, max)?)?;
         Ok(())
     })
 }
@@ -290,9 +296,7 @@ unsafe fn add_container_box(
     let args = unsafe { Args::trusted() };
     status_call(name, || {
         let mut world = args.world(world)?;
-        let (min, max) = (read_vec3(args, min, "min")?, read_vec3(args, max, "max")?);
-        let (min, max) = (check_finite(min, "min")?, check_finite(max, "max")?);
-        let (container, layers) = (Aabb { min, max }, layers as usize);
+        let (container, layers) = (read_corners(args, min, max)?, layers as usize);
         match spacing {
             Some(spacing) => world.add_container_spaced(container, layers, spacing)?,
             None => world.add_container(container, layers)?,

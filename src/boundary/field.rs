@@ -208,7 +208,7 @@ impl WallField {
         // B₁·B₂/P is ill-conditioned where P and both B vanish together, H from the plane:
         // there the interpolated B are not as small as P (tested). P + ε in its place changes
         // the term by at most ε there and nothing where it matters, next to the corner.
-        let q = p + CORNER_REGULARIZATION * kernel.plane_integral(0.0);
+        let q = corner_denominator(p, kernel);
         for b1 in &beyond[0] {
             for b2 in &beyond[1] {
                 let both = b1.value * b2.value;
@@ -240,6 +240,12 @@ struct Share {
 
 /// ε of the corner term B₁·B₂/(P + ε), relative to P(0).
 const CORNER_REGULARIZATION: f64 = 1e-3;
+
+/// P + ε, the corner term's denominator, for the plane's integral `p` (1/m).
+#[inline(always)]
+fn corner_denominator(p: f64, kernel: &CubicKernel) -> f64 {
+    p + CORNER_REGULARIZATION * kernel.plane_integral(0.0)
+}
 
 /// The moves, in H, for which [`WallContribution::curvature`] bounds the walls' curvature.
 pub const SHORT_MOVE: f64 = 0.25;
@@ -406,7 +412,7 @@ mod tests {
             let b: Vec<f64> = (0..=100)
                 .map(|j| table.beyond(depth / h, j as f64 / 100.0).g / h)
                 .collect();
-            let q = kernel.plane_integral(depth) + CORNER_REGULARIZATION * p0;
+            let q = corner_denominator(kernel.plane_integral(depth), &kernel);
             for (b1, b2) in b.iter().flat_map(|b1| b.iter().map(move |b2| (b1, b2))) {
                 excess = excess.max((b1 * b2).abs() / q - b1.abs().min(b2.abs()));
             }

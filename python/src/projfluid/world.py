@@ -162,8 +162,7 @@ class World(BodiesMixin, FlowMixin):
         "particles" its walls are ``layers`` (1–3) layers of boundary particles growing
         outward, at most ``spacing`` (m, from r/4 to 2r; None: r) apart; with "field" each
         wall is a smooth field that adds what such a wall adds on average, with no particles
-        (as scene files have it unless they ask for particles; ``layers`` 1 and ``spacing``
-        None only)."""
+        (a scene file's ``"walls": "field"``; ``layers`` 1 and ``spacing`` None only)."""
         if walls not in ("particles", "field"):
             raise ValueError(f'walls must be "particles" or "field", got {walls!r}')
         if layers < 0:

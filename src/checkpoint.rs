@@ -6,13 +6,13 @@
 //! masses) from the scene, so a body's mesh file must still be readable, and their poses,
 //! velocities and loads from the state.
 //!
-//! Layout: the magic `PFCHECK3`; the length (u64, little-endian) of a JSON header, the
+//! Layout: the magic `PFCHECK4`; the length (u64, little-endian) of a JSON header, the
 //! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
 //! containers (and which of them have walls that are fields), grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
 //! velocities and loads, the next particle id, the removed count, sinks, domain and
-//! emitters); the fluid positions, velocities and densities as f64 triples/values, the
-//! particle ids as u64, the static boundary positions as f64 triples and their owners as
-//! u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged
+//! emitters); the fluid positions, velocities, supports (docs/method.md §4.1) and densities
+//! as f64 triples/values, the particle ids as u64, the static boundary positions as f64
+//! triples and their owners as u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged
 //! or truncated file is refused.
 
 mod header;
@@ -24,11 +24,12 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK3";
-/// The magics of earlier formats, named in the errors that refuse them: before bodies, and
-/// before particle ids, sinks and emitters.
+const MAGIC: &[u8; 8] = b"PFCHECK4";
+/// The magics of earlier formats, named in the errors that refuse them: before bodies,
+/// before particle ids, sinks and emitters, and before the warm start's supports.
 const MAGIC_V1: &[u8; 8] = b"PFCHECK1";
 const MAGIC_V2: &[u8; 8] = b"PFCHECK2";
+const MAGIC_V3: &[u8; 8] = b"PFCHECK3";
 const DIGEST_LEN: usize = 32;
 
 /// Where the interrupted run was going to stop.
@@ -89,13 +90,18 @@ pub fn write_checkpoint(
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
     let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 64 + f.boundary_positions.len() * 28,
+        64 + json.len() + f.positions.len() * 88 + f.boundary_positions.len() * 28,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
     bytes.extend_from_slice(&json);
     for v in f.positions.iter().chain(&f.velocities) {
         push_vec3(&mut bytes, v);
+    }
+    // No supports (the warm start off) are written as zeros, which resume alike.
+    let zero = Vec3::zeros();
+    for i in 0..f.positions.len() {
+        push_vec3(&mut bytes, f.supports.get(i).unwrap_or(&zero));
     }
     for d in &f.densities {
         bytes.extend_from_slice(&d.to_le_bytes());
@@ -149,6 +155,12 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
              emitters, which this version cannot resume",
         ));
     }
+    if bytes.starts_with(MAGIC_V3) {
+        return Err(bad(
+            "is a checkpoint of an earlier version without the warm start's supports, which \
+             this version cannot resume",
+        ));
+    }
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
@@ -175,7 +187,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
     let (n, m) = (header.fluid_count, header.boundary_count);
     let expected = n
-        .checked_mul(3 * 8 * 2 + 8 + 8)
+        .checked_mul(3 * 8 * 3 + 8 + 8)
         .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
@@ -192,6 +204,10 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let mut data = Reader(&body[header_end..]);
     let positions = data.vec3s(n);
     let velocities = data.vec3s(n);
+    let mut supports = data.vec3s(n);
+    if supports.iter().all(|a| *a == Vec3::zeros()) {
+        supports = Vec::new();
+    }
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
     let ids: Vec<u64> = (0..n).map(|_| u64::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
@@ -208,6 +224,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         next_dt: header.next_dt,
         positions,
         velocities,
+        supports,
         densities,
         ids,
         next_id: header.next_id,

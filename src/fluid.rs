@@ -12,6 +12,11 @@ pub(crate) struct Fluid {
     pub velocities: Vec<Vec3>,
     /// Densities after the last step (kg/m³; zero before the first step).
     pub densities: Vec<f64>,
+    /// The support each particle's constraints gave it in the last step, per unit mass
+    /// (m/s²): its displacement from the inertial prediction over Δt², or zero where no
+    /// active constraint moved it; the next step starts from a share of it
+    /// (docs/method.md §4.1). Empty while the warm start is off, else one per particle.
+    pub supports: Vec<Vec3>,
     /// Each stored particle's id: given in the order particles were added, never reused.
     pub ids: Vec<u64>,
     /// The ids of the stored particles in ascending order, the order of every read.
@@ -46,6 +51,9 @@ impl Fluid {
         let count = (self.positions.len() - before) as u64;
         self.velocities.extend(velocities);
         self.densities.resize(self.positions.len(), 0.0);
+        if !self.supports.is_empty() {
+            self.supports.resize(self.positions.len(), Vec3::zeros());
+        }
         self.ids.extend(first..first + count);
         self.ascending.extend(first..first + count);
         self.next_id = first + count;
@@ -57,6 +65,7 @@ impl Fluid {
         self.positions.truncate(len);
         self.velocities.truncate(len);
         self.densities.truncate(len);
+        self.supports.truncate(len);
         self.ids.truncate(len);
         self.ascending.truncate(len);
         self.next_id = next_id;
@@ -96,6 +105,9 @@ impl Fluid {
             self.positions[kept] = self.positions[i];
             self.velocities[kept] = self.velocities[i];
             self.densities[kept] = self.densities[i];
+            if let Some(&a) = self.supports.get(i) {
+                self.supports[kept] = a;
+            }
             self.ids[kept] = id;
             kept += 1;
         }
@@ -105,6 +117,7 @@ impl Fluid {
         self.positions.truncate(kept);
         self.velocities.truncate(kept);
         self.densities.truncate(kept);
+        self.supports.truncate(kept);
         self.ids.truncate(kept);
         gone.sort_unstable();
         self.ascending.retain(|id| gone.binary_search(id).is_err());

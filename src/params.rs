@@ -225,6 +225,12 @@ pub struct Params {
     pub density_tolerance: f64,
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in an iteration.
     pub displacement_tolerance: f64,
+    /// Share f of the last step's support a step starts from (dimensionless, in [0, 1); 0, the
+    /// default, starts every step from its prediction s): particles that active constraints
+    /// moved in the last step start the outer iteration from s + f·Δt²·a, a being that
+    /// step's displacement from its own s per Δt², at most 2|g| (docs/method.md §4.1). Not
+    /// used in worlds with bodies nor in the calm settings.
+    pub warm_start: f64,
     /// Smallest number of outer iterations per step (≥ 1).
     pub min_outer_iterations: usize,
     /// Largest number of outer iterations per step.
@@ -270,6 +276,10 @@ pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
 /// "Accuracy per cost").
 pub const DEFAULT_DENSITY_TOLERANCE: f64 = 3e-4;
 
+/// The default [`Params::warm_start`]: off. A start saves outer iterations but leaves a trace
+/// of the last step's support in the result, measured in the Martin & Moyce residual height
+/// and in the pressures of a tank at rest (docs/method.md §4.1).
+pub const DEFAULT_WARM_START: f64 = 0.0;
 /// Default CFL factor λ, chosen by measurement on `dam_break_30k` (docs/method.md §8): at
 /// 1.25 a particle moves at most r per step, and the outer iterations per simulated second
 /// are about those of shorter steps, so a simulated second takes fewer steps.
@@ -327,6 +337,7 @@ impl Params {
             chebyshev: ChebyshevParams::default(),
             density_tolerance: DEFAULT_DENSITY_TOLERANCE,
             displacement_tolerance: DEFAULT_TOLERANCE_PER_RADIUS * r,
+            warm_start: DEFAULT_WARM_START,
             min_outer_iterations: 1,
             max_outer_iterations: 100,
             projection_weight: ProjectionWeight::NeighborCount,
@@ -343,13 +354,16 @@ impl Params {
     /// the [`ProjectionWeight::Uniform`] weighting, whose converged constraint forces derive
     /// from one energy; τ = [`CALM_TOLERANCE_PER_RADIUS`]·r; Chebyshev at a fixed ρ = 0.99
     /// with γ = 0.5, which keeps the iteration convergent in fully compressed fluid (where the
-    /// summed projections overshoot by up to ≈ 3.8). A settled tank stays at rest under them;
-    /// they cost 2–4× the outer iterations of the defaults.
+    /// summed projections overshoot by up to ≈ 3.8); and every step from its prediction (no
+    /// warm start, whose start would carry part of the weight outside the constraints). A
+    /// settled tank stays at rest under them; they cost 2–4× the outer iterations of the
+    /// defaults.
     pub fn calm(self) -> Self {
         Self {
             projection_weight: ProjectionWeight::Uniform,
             density_tolerance: 0.0,
             displacement_tolerance: CALM_TOLERANCE_PER_RADIUS * self.particle_radius,
+            warm_start: 0.0,
             chebyshev: ChebyshevParams {
                 rho: 0.99,
                 gamma: 0.5,
@@ -388,13 +402,34 @@ impl Params {
 mod tests {
     use super::*;
 
-    /// The calm settings change the weighting, τ (scaled by the radius) and the Chebyshev
-    /// settings, keep every other field, and validate.
+    /// A warm start's share lies in [0, 1): others are refused, naming the field.
+    #[test]
+    fn a_warm_start_share_outside_zero_to_one_is_refused() {
+        for share in [0.0, 0.45, 0.99] {
+            let p = Params {
+                warm_start: share,
+                ..Params::default()
+            };
+            p.validate().unwrap();
+        }
+        for share in [-0.1, 1.0, 2.0, f64::NAN, f64::INFINITY] {
+            let p = Params {
+                warm_start: share,
+                ..Params::default()
+            };
+            let message = p.validate().unwrap_err().to_string();
+            assert!(message.contains("warm_start"), "{share}: {message}");
+        }
+    }
+
+    /// The calm settings change the weighting, τ (scaled by the radius), the Chebyshev
+    /// settings and the warm start, keep every other field, and validate.
     #[test]
     fn calm_changes_only_the_solver_settings() {
         let base = Params {
             solver: SolverKind::Jacobi1,
             threads: 3,
+            warm_start: 0.5,
             ..Params::with_radius(0.01)
         };
         let calm = base.clone().calm();
@@ -412,9 +447,11 @@ mod tests {
             (0.99, 0.5, false)
         );
         assert_eq!(calm.density_tolerance, 0.0);
+        assert_eq!(calm.warm_start, 0.0);
         let restored = Params {
             projection_weight: base.projection_weight,
             density_tolerance: base.density_tolerance,
+            warm_start: base.warm_start,
             displacement_tolerance: base.displacement_tolerance,
             chebyshev: base.chebyshev,
             ..calm.clone()

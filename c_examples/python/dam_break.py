@@ -36,6 +36,7 @@ class PfParams(ctypes.Structure):
         ("projection_weight", c_int),
         ("density_tolerance", c_double),
         ("displacement_tolerance", c_double),
+        ("warm_start", c_double),
         ("min_outer_iterations", c_uint32),
         ("max_outer_iterations", c_uint32),
         ("cfl_factor", c_double),

@@ -1,5 +1,5 @@
-//! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, before
-//! the first step, with rigid bodies, and with emitters, sinks and removed particles), and
+//! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, with
+//! the warm start's supports, before the first step, with rigid bodies, and with emitters, sinks and removed particles), and
 //! refused damaged, truncated, foreign and earlier-format files.
 
 use super::*;
@@ -46,6 +46,48 @@ fn a_resumed_world_continues_bit_for_bit() {
     assert!(resumed.velocities() == reference.velocities());
 }
 
+/// Checkpoints `reference` (built from `scene`) to a file named by `tag` and resumes it
+/// twice, once as saved and once changed by `forget`; after `steps` more steps of all three,
+/// the first matches the reference bit for bit and the forgetful one does not.
+fn resumed_matches_and_forgetful_does_not(
+    tag: &str,
+    scene: &Scene,
+    mut reference: World,
+    steps: usize,
+    forget: impl FnOnce(&mut World),
+) {
+    let path = temp(&format!("{tag}.pfck"));
+    write_checkpoint(&path, scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    let mut forgetful = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    forget(&mut forgetful);
+    for _ in 0..steps {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+        forgetful.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_ne!(forgetful.positions_hash(), reference.positions_hash());
+}
+
+/// With the warm start, every particle's support is part of the state: a resumed run
+/// matches, one that forgot the supports does not.
+#[test]
+fn a_resumed_world_keeps_its_supports() {
+    let mut scene = small_scene();
+    scene.params.warm_start = 0.45;
+    let mut reference = scene.build_world().unwrap();
+    for _ in 0..20 {
+        reference.step().unwrap();
+    }
+    let supported = reference.fluid.supports.iter().filter(|a| a.norm() > 0.0);
+    assert!(supported.count() > 100, "the column must be supported");
+    resumed_matches_and_forgetful_does_not("supports", &scene, reference, 20, |w| {
+        w.fluid.supports.fill(Vec3::zeros())
+    });
+}
+
 /// With ρ_c estimated online, the estimate is part of the state: a resumed run matches,
 /// one that forgot the estimate does not.
 #[test]
@@ -61,20 +103,11 @@ fn a_resumed_world_keeps_its_online_rho() {
     }
     let saved = reference.chebyshev.online();
     assert!(saved.contraction.is_some(), "{saved:?}");
-    let path = temp("online-rho.pfck");
-    write_checkpoint(&path, &scene, &reference, None).unwrap();
-    let mut resumed = read_checkpoint(&path, None).unwrap().world;
-    let mut forgetful = read_checkpoint(&path, None).unwrap().world;
-    std::fs::remove_file(&path).unwrap();
-    assert_eq!(resumed.chebyshev.online(), saved);
-    forgetful.chebyshev = crate::solver::Chebyshev::new(scene.params.chebyshev);
-    for _ in 0..30 {
-        reference.step().unwrap();
-        resumed.step().unwrap();
-        forgetful.step().unwrap();
-    }
-    assert_eq!(resumed.positions_hash(), reference.positions_hash());
-    assert_ne!(forgetful.positions_hash(), reference.positions_hash());
+    let params = scene.params.chebyshev;
+    resumed_matches_and_forgetful_does_not("online-rho", &scene, reference, 30, |w| {
+        assert_eq!(w.chebyshev.online(), saved);
+        w.chebyshev = crate::solver::Chebyshev::new(params);
+    });
 }
 
 #[test]
@@ -183,11 +216,12 @@ fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
     assert_eq!(resumed.export_state(), reference.export_state());
 }
 
-/// A checkpoint of the format before stable ids is refused with a message saying so.
+/// A checkpoint of an earlier format is refused with a message saying what it lacks.
 #[test]
 fn checkpoints_of_earlier_formats_are_refused() {
     let path = temp("v2.pfck");
     for (magic, words) in [
+        (MAGIC_V3, "warm start's supports"),
         (MAGIC_V2, "stable particle ids"),
         (MAGIC_V1, "without bodies"),
     ] {

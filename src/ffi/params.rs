@@ -95,6 +95,12 @@ pub struct PfParams {
     /// Outer stopping threshold τ (m): stop when no particle moved more than τ in one
     /// outer iteration. Default 3e-3·r.
     pub displacement_tolerance: f64,
+    /// Share f of the last step's support a step starts from, in [0, 1) (0: every step
+    /// starts from its prediction s): particles that active constraints moved in the last
+    /// step start the outer iteration from s + f·Δt²·a, a being that step's displacement from
+    /// its prediction per Δt² (m/s², at most 2|g|). Not used in worlds with bodies; 0 in the
+    /// calm settings. Default 0.
+    pub warm_start: f64,
     /// Smallest number of outer iterations per step (≥ 1). Default 1.
     pub min_outer_iterations: u32,
     /// Largest number of outer iterations per step (≤ 100000). Default 100. Where Chebyshev's
@@ -148,6 +154,7 @@ impl From<&Params> for PfParams {
             },
             density_tolerance: p.density_tolerance,
             displacement_tolerance: p.displacement_tolerance,
+            warm_start: p.warm_start,
             min_outer_iterations: small(p.min_outer_iterations),
             max_outer_iterations: small(p.max_outer_iterations),
             cfl_factor: p.cfl_factor,
@@ -236,6 +243,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         },
         density_tolerance: field!(density_tolerance),
         displacement_tolerance: field!(displacement_tolerance),
+        warm_start: field!(warm_start),
         min_outer_iterations: count(field!(min_outer_iterations)),
         max_outer_iterations: count(field!(max_outer_iterations)),
         projection_weight,

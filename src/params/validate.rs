@@ -70,6 +70,13 @@ impl Params {
                 "must lie in [0, 1) (0 turns the density rule off)",
             ));
         }
+        if !(self.warm_start.is_finite() && (0.0..1.0).contains(&self.warm_start)) {
+            return Err(Error::invalid(
+                "warm_start",
+                self.warm_start,
+                "must lie in [0, 1) (0 starts every step from its prediction)",
+            ));
+        }
         let c = &self.chebyshev;
         if !(c.rho.is_finite() && (0.0..1.0).contains(&c.rho)) {
             return Err(Error::invalid("rho", c.rho, "must lie in [0, 1)"));

@@ -69,6 +69,7 @@ struct SolverFile {
     gamma: Option<f64>,
     eta: Option<f64>,
     tau: Option<f64>,
+    warm_start: Option<f64>,
     max_iterations: Option<usize>,
     min_iterations: Option<usize>,
     projection_weight: Option<ProjectionWeight>,
@@ -226,6 +227,7 @@ impl SceneFile {
         set(&mut c.gamma, s.gamma);
         set(&mut p.density_tolerance, s.eta);
         set(&mut p.displacement_tolerance, s.tau);
+        set(&mut p.warm_start, s.warm_start);
         p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
         p.min_outer_iterations = s.min_iterations.unwrap_or(p.min_outer_iterations);
         p.projection_weight = s.projection_weight.unwrap_or(p.projection_weight);
@@ -317,6 +319,7 @@ impl SceneFile {
                 gamma: Some(c.gamma),
                 eta: Some(p.density_tolerance),
                 tau: Some(p.displacement_tolerance),
+                warm_start: Some(p.warm_start),
                 max_iterations: Some(p.max_outer_iterations),
                 min_iterations: Some(p.min_outer_iterations),
                 projection_weight: Some(p.projection_weight),

@@ -1,11 +1,12 @@
 //! The outer local/global iteration of a step (docs/method.md §1.3, §3, §4): the system
 //! matrix of formulation F1 frozen for the step, then local projections and global solves
-//! from X^(0) = X^(−1) = s, with Chebyshev's extrapolation, until the fluid's average
-//! compression is at most η (once no particle moves farther than 10τ) or no particle moved
-//! farther than τ; a step whose extrapolation reaches K_max starts over without it.
+//! from X^(0) = X^(−1) = s or its warm start (§4.1), with Chebyshev's extrapolation, until
+//! the fluid's average compression is at most η (once no particle moves farther than 10τ)
+//! or no particle moved farther than τ; a step whose extrapolation reaches K_max starts
+//! over from s without it.
 
 use super::search::Prediction;
-use super::{StepBuffers, couple};
+use super::{StepBuffers, couple, warm_start};
 use crate::boundary::Boundary;
 use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection};
 use crate::fluid::Fluid;
@@ -38,6 +39,8 @@ pub(super) struct Iteration<'a> {
     pub dt: f64,
     /// Follow the boundary's share of the displacement in `b.coupling` (worlds with bodies).
     pub couple: bool,
+    /// Start from the warm start rather than from s (docs/method.md §4.1).
+    pub warm: bool,
 }
 
 /// How the iteration ended.
@@ -76,6 +79,7 @@ pub(super) fn iterate(
         chebyshev,
         dt,
         couple,
+        warm,
     } = it;
     // The system matrix of formulation F1, frozen for the step.
     let mass = constraint.mass;
@@ -89,6 +93,11 @@ pub(super) fn iterate(
         .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
     solver.prepare(&b.system)?;
 
+    // The fluid keeps one support per particle (every change of its particles keeps them).
+    if warm && fluid.supports.len() == fluid.len() {
+        let (share, reach) = (params.warm_start, params.particle_radius);
+        warm_start::start(&mut b.current, &fluid.supports, &b.order, share, dt, reach);
+    }
     b.previous.clone_from(&b.current);
     constraint.weights(&b.fluid_lists, &mut b.weights);
     let nb = Neighborhood {

@@ -14,6 +14,7 @@ mod finish;
 mod iterate;
 mod search;
 mod undo;
+mod warm_start;
 
 pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
@@ -124,6 +125,9 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
     search::predict(pool, fluid, dt, gravity, &mut buffers.current);
     let mut timings = StepTimings::default();
     let couple = !bodies.is_empty();
+    // In worlds with bodies every particle starts from s: a body's load is read from the
+    // corrections the iteration makes (docs/method.md §11.3), which a start would bypass.
+    let warm = params.warm_start > 0.0 && !couple;
     let iterated = pool.install(|| {
         let grid = grid.sorted(pool, params, &constraint.kernel, boundary, buffers)?;
         if boundary.has_moving() {
@@ -153,6 +157,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 chebyshev,
                 dt,
                 couple,
+                warm,
             },
             buffers,
             &mut timings,
@@ -172,6 +177,19 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
         let t = Instant::now();
         search::permute_fluid(fluid, buffers);
         timings.neighbors += t.elapsed().as_secs_f64();
+        // The fluid is in the sort's order now, its positions and velocities still those
+        // the step started from.
+        let mut supports = std::mem::take(&mut fluid.supports);
+        if warm {
+            let predicted = &search::Prediction::new(fluid, None, dt, gravity);
+            let (lists, corrections) = (&buffers.fluid_lists, &buffers.corrections);
+            let x = &buffers.current;
+            let limit = warm_start::SUPPORT_LIMIT * gravity.norm();
+            warm_start::record(&mut supports, x, predicted, dt, lists, corrections, limit);
+        } else {
+            warm_start::none(&mut supports);
+        }
+        fluid.supports = supports;
         if couple {
             let loads = &mut buffers.loads;
             let predicted = &search::Prediction::new(fluid, None, dt, gravity);

@@ -33,6 +33,10 @@ pub struct WorldState {
     pub velocities: Vec<Vec3>,
     /// Fluid densities after the last step (kg/m³).
     pub densities: Vec<f64>,
+    /// The support the constraints gave each fluid particle in the last step, per unit mass
+    /// (m/s²), which the next step's warm start reads (docs/method.md §4.1): empty while the
+    /// warm start is off.
+    pub supports: Vec<Vec3>,
     /// Each stored fluid particle's id (docs/method.md §12.1): unique, below `next_id`.
     pub ids: Vec<u64>,
     /// The id the next added particle gets: the number of particles ever added.
@@ -92,6 +96,7 @@ impl World {
             positions: fluid.positions.clone(),
             velocities: fluid.velocities.clone(),
             densities: fluid.densities.clone(),
+            supports: fluid.supports.clone(),
             ids: fluid.ids.clone(),
             next_id: fluid.next_id,
             removed_count: fluid.removed,
@@ -140,6 +145,14 @@ impl World {
         }
         super::check_finite("state.positions", &state.positions)?;
         super::check_finite("state.velocities", &state.velocities)?;
+        if !state.supports.is_empty() && state.supports.len() != n {
+            return Err(Error::invalid(
+                "state.supports",
+                state.supports.len(),
+                &format!("must be empty or hold one support per particle ({n})"),
+            ));
+        }
+        super::check_finite("state.supports", &state.supports)?;
         super::check_finite("state.boundary_positions", &state.boundary_positions)?;
         let ascending = checked_ids(&state)?;
         for (k, sink) in state.sinks.iter().enumerate() {
@@ -241,6 +254,7 @@ impl World {
         fluid.positions = state.positions;
         fluid.velocities = state.velocities;
         fluid.densities = state.densities;
+        fluid.supports = state.supports;
         fluid.ids = state.ids;
         fluid.ascending = ascending;
         fluid.next_id = state.next_id;

@@ -121,6 +121,11 @@ class Params:
     moved no particle farther than 10 times ``displacement_tolerance`` (0 turns the rule off)."""
     displacement_tolerance: float = _C_DEFAULTS.displacement_tolerance
     """Outer stopping threshold τ (m): stop when no particle moved more than τ."""
+    warm_start: float = _C_DEFAULTS.warm_start
+    """Share f in [0, 1) of the last step's support a step starts from: particles that
+    active constraints moved in the last step start the outer iteration from s + f·Δt²·a,
+    a being that step's displacement from its prediction per Δt² (0 starts every step from
+    its prediction s, the default). Not used in worlds with bodies."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations
     """Smallest number of outer iterations per step (≥ 1)."""
     max_outer_iterations: int = _C_DEFAULTS.max_outer_iterations

@@ -47,7 +47,7 @@ fn every_key_is_read() {
             "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "walls": "particles", "layers": 2}],
             "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2], "velocity": [0, 1, 0]}],
             "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "paper", "gamma": 0.9,
-                       "tau": 1e-6, "max_iterations": 50, "min_iterations": 2,
+                       "tau": 1e-6, "warm_start": 0.3, "max_iterations": 50, "min_iterations": 2,
                        "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
             "viscosity": 0.02, "threads": 2, "duration": 3,
@@ -71,6 +71,7 @@ fn every_key_is_read() {
     assert_eq!(p.chebyshev.omega2_rule, crate::Omega2Rule::Paper);
     assert_eq!(p.chebyshev.gamma, 0.9);
     assert_eq!(p.displacement_tolerance, 1e-6);
+    assert_eq!(p.warm_start, 0.3);
     assert_eq!((p.min_outer_iterations, p.max_outer_iterations), (2, 50));
     assert_eq!(p.projection_weight, crate::ProjectionWeight::Unit);
     assert_eq!(

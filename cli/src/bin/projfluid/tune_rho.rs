@@ -62,6 +62,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         rho: None,
         eta: None,
         tau: args.tau,
+        warm_start: None,
         threads: args.threads,
     };
     options.apply_checked(&mut scene)?;

@@ -20,6 +20,10 @@ pub(crate) struct ParamOptions {
     /// Outer stopping threshold τ, in metres (stop when no particle moves farther).
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     pub(crate) tau: Option<f64>,
+    /// Share of the last step's support a step starts from, in [0, 1) (0 starts every
+    /// step from its inertial prediction).
+    #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
+    pub(crate) warm_start: Option<f64>,
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N")]
     pub(crate) threads: Option<usize>,
@@ -38,17 +42,25 @@ impl ParamOptions {
         if let Some(tau) = self.tau {
             p.displacement_tolerance = tau;
         }
+        if let Some(share) = self.warm_start {
+            p.warm_start = share;
+        }
         if let Some(threads) = self.threads {
             p.threads = threads;
         }
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 4] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 5] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
             ("solver.eta", "--eta", self.eta.is_some()),
             ("solver.tau", "--tau", self.tau.is_some()),
+            (
+                "solver.warm_start",
+                "--warm-start",
+                self.warm_start.is_some(),
+            ),
             ("threads", "--threads", self.threads.is_some()),
         ]
     }

@@ -8,12 +8,13 @@
 //!
 //! Layout: the magic `PFCHECK4`; the length (u64, little-endian) of a JSON header, the
 //! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
-//! containers (and which of them have walls that are fields), grid, counts, the run's end, the online ρ_c estimate, the bodies' poses,
-//! velocities and loads, the next particle id, the removed count, sinks, domain and
-//! emitters); the fluid positions, velocities, supports (docs/method.md §4.1) and densities
-//! as f64 triples/values, the particle ids as u64, the static boundary positions as f64
-//! triples and their owners as u32 (all little-endian); and a SHA-256 digest of everything before it, so that a damaged
-//! or truncated file is refused.
+//! containers (and which of them have walls that are fields), grid, counts, the run's end,
+//! the online ρ_c estimate, the bodies' poses, velocities and loads, the next particle id,
+//! the removed count, sinks, domain and emitters); the fluid positions, velocities,
+//! supports (docs/method.md §4.1; zeros while the warm start is off) and densities as f64
+//! triples/values, the particle ids as u64, the static boundary positions as f64 triples
+//! and their owners as u32 (all little-endian); and a SHA-256 digest of everything before
+//! it, so that a damaged or truncated file is refused.
 
 mod header;
 

@@ -93,7 +93,8 @@ pub(super) fn iterate(
         .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
     solver.prepare(&b.system)?;
 
-    // The fluid keeps one support per particle (every change of its particles keeps them).
+    // The fluid holds one support per particle once a step with the warm start recorded
+    // them (none before: the iteration then starts from s).
     if warm && fluid.supports.len() == fluid.len() {
         let (share, reach) = (params.warm_start, params.particle_radius);
         warm_start::start(&mut b.current, &fluid.supports, &b.order, share, dt, reach);

@@ -1,6 +1,7 @@
 //! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, with
-//! the warm start's supports, before the first step, with rigid bodies, and with emitters, sinks and removed particles), and
-//! refused damaged, truncated, foreign and earlier-format files.
+//! the warm start's supports, before the first step, with rigid bodies, and with emitters,
+//! sinks and removed particles), and refused damaged, truncated, foreign and earlier-format
+//! files.
 
 use super::*;
 use crate::body::BodyState;

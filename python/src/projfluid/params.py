@@ -125,7 +125,7 @@ class Params:
     """Share f in [0, 1) of the last step's support a step starts from: particles that
     active constraints moved in the last step start the outer iteration from s + f·Δt²·a,
     a being that step's displacement from its prediction per Δt² (0 starts every step from
-    its prediction s, the default). Not used in worlds with bodies."""
+    its prediction s, the default). Not used in worlds with bodies; 0 in the calm settings."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations
     """Smallest number of outer iterations per step (≥ 1)."""
     max_outer_iterations: int = _C_DEFAULTS.max_outer_iterations
@@ -155,8 +155,8 @@ class Params:
 
     def calm(self) -> Params:
         """A copy with the calm settings (``pf_params_calm``: uniform weighting, Chebyshev
-        at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4·r) under which a settled tank stays at
-        rest; every other field is kept."""
+        at a fixed ρ = 0.99 with γ = 0.5, τ = 3e-4·r, no warm start) under which a settled
+        tank stays at rest; every other field is kept."""
         c = self.to_c()
         check(lib.pf_params_calm(byref(c)))
         return Params.from_c(c)

@@ -277,8 +277,8 @@ pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
 pub const DEFAULT_DENSITY_TOLERANCE: f64 = 3e-4;
 
 /// The default [`Params::warm_start`]: off. A start saves outer iterations but leaves a trace
-/// of the last step's support in the result, measured in the Martin & Moyce residual height
-/// and in the pressures of a tank at rest (docs/method.md §4.1).
+/// of the last step's support in the result: a collapsing column's surge runs slower and
+/// loses more energy, and a tank at rest reads lower pressures (docs/method.md §4.1).
 pub const DEFAULT_WARM_START: f64 = 0.0;
 /// Default CFL factor λ, chosen by measurement on `dam_break_30k` (docs/method.md §8): at
 /// 1.25 a particle moves at most r per step, and the outer iterations per simulated second

@@ -178,7 +178,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
         search::permute_fluid(fluid, buffers);
         timings.neighbors += t.elapsed().as_secs_f64();
         // The fluid is in the sort's order now, its positions and velocities still those
-        // the step started from.
+        // the step started from. Without the warm start no supports are kept.
         let mut supports = std::mem::take(&mut fluid.supports);
         if warm {
             let predicted = &search::Prediction::new(fluid, None, dt, gravity);
@@ -186,10 +186,8 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             let x = &buffers.current;
             let limit = warm_start::SUPPORT_LIMIT * gravity.norm();
             warm_start::record(&mut supports, x, predicted, dt, lists, corrections, limit);
-        } else {
-            warm_start::none(&mut supports);
+            fluid.supports = supports;
         }
-        fluid.supports = supports;
         if couple {
             let loads = &mut buffers.loads;
             let predicted = &search::Prediction::new(fluid, None, dt, gravity);

@@ -66,8 +66,3 @@ pub(super) fn record(
         }
     }));
 }
-
-/// No supports kept (the warm start is off), and their memory given back.
-pub(super) fn none(supports: &mut Vec<Vec3>) {
-    *supports = Vec::new();
-}

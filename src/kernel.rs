@@ -137,28 +137,6 @@ impl CubicKernel {
         r * self.grad_w_coefficient(len)
     }
 
-    /// [`CubicKernel::w`] in single precision, for the pair geometry of a stencil
-    /// (docs/method.md §2.5, "Precision"): W at distance `r` (m), in 1/m³.
-    #[inline]
-    pub fn w_f32(&self, r: f32) -> f32 {
-        let q = r * self.inverse_support as f32;
-        let outer = (1.0 - q).max(0.0);
-        let inner = (0.5 - q).max(0.0);
-        self.sigma as f32 * (2.0 * outer * outer * outer - 8.0 * inner * inner * inner)
-    }
-
-    /// [`CubicKernel::grad_w_coefficient`] in single precision: the factor c with
-    /// ∇W(r) = c·r for an offset of length `len` (m), in 1/m⁵.
-    #[inline]
-    pub fn grad_w_coefficient_f32(&self, len: f32) -> f32 {
-        let q = len * self.inverse_support as f32;
-        let outer = (1.0 - q).max(0.0);
-        let inner = (0.5 - q).max(0.0);
-        let shape = 4.0 * inner * inner - outer * outer;
-        let c = self.gradient_factor as f32 * shape / len;
-        if len > GRADIENT_CUTOFF as f32 { c } else { 0.0 }
-    }
-
     /// The factor c with ∇W(r) = c·r for an offset of length `len` (m), in 1/m⁵: zero at
     /// or below the cutoff and beyond H. Written as a select, so loops over many lengths
     /// vectorise.

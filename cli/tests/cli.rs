@@ -691,13 +691,12 @@ fn bench_writes_one_consistent_row_per_scene_and_solver() {
     for exact in ["jacobi", "cg", "ldlt"] {
         assert_eq!(outer(exact), outer("jacobi1"), "{exact}");
     }
-    // One Jacobi sweep or CG iteration per outer iteration; converged CG needs one or more:
-    // more where the residual spans particles of different diagonals, but the first steps'
-    // residuals are so small against ‖b‖ that one iteration may reach 10⁻¹⁰‖b‖ in each.
+    // One Jacobi sweep or CG iteration per outer iteration; converged CG needs one or more,
+    // more where the diagonal varies.
     let inner = |i: usize| number(&header, &rows[i], "inner_iterations_mean");
     assert_eq!(inner(1), outer("jacobi1"));
     assert_eq!(inner(4), outer("cg1"));
-    assert!(inner(3) >= outer("cg"));
+    assert!(inner(3) > outer("cg"));
     assert_png(&out_dir.join("bench.png"));
     assert_png(&out_dir.join("bench_iterations.png"));
     std::fs::remove_dir_all(&dir).unwrap();

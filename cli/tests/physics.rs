@@ -159,14 +159,13 @@ fn cluster_momentum(weight: ProjectionWeight) -> f64 {
     v.iter().sum::<Vec3>().norm() / moving
 }
 
-/// The uniform weighting conserves linear momentum exactly, to the round-off of the pair
-/// geometry's single precision (docs/method.md §2.5; measured: 3·10⁻⁹); the neighbour-count
-/// weighting, whose weights differ between the members of a stencil, does not (over 10⁻⁴).
+/// The uniform weighting conserves linear momentum exactly (to round-off); the neighbour-count
+/// weighting, whose weights differ between the members of a stencil, does not.
 #[test]
 fn uniform_weighting_conserves_momentum() {
     let uniform = cluster_momentum(ProjectionWeight::Uniform);
     let counted = cluster_momentum(ProjectionWeight::NeighborCount);
-    assert!(uniform < 1e-7, "uniform: |P|/Σm|v| = {uniform:e}");
+    assert!(uniform < 1e-12, "uniform: |P|/Σm|v| = {uniform:e}");
     assert!(counted > 1e-4, "neighbour count: |P|/Σm|v| = {counted:e}");
 }
 
@@ -279,11 +278,9 @@ fn chebyshev_needs_fewer_outer_iterations_than_plain() {
 /// is active from the first step (from rest density few are, and the comparison would see
 /// little), and every step runs exactly 6 outer iterations, so that no stopping decision,
 /// which round-off can move by one iteration, separates the runs. Over 8 steps the
-/// converging solvers then agree with one exact Jacobi sweep to 1e-5 of the container size
-/// (measured: 5e-7 for CG, 1e-11 for LDLᵀ, 0 for Jacobi: CG's tolerance moves a position by
-/// about 1e-10 m, and where that changes its rounding to single precision for the pair
-/// geometry, docs/method.md §2.5, by 1e-7 m), while cg1 and the stiffer matrix differ by more
-/// than 1e-4 of it (measured: 1e-3). Later, a neighbour entering the kernel's support of one run a step
+/// converging solvers then agree with one exact Jacobi sweep to 1e-12 of the container size
+/// (measured: 3e-14), while cg1 and the stiffer matrix differ by more than 1e-4 of it
+/// (measured: 1e-3). Later, a neighbour entering the kernel's support of one run a step
 /// before the other changes a membership count, and even LDLᵀ and Jacobi part by ~1e-4.
 #[test]
 fn converging_global_solvers_agree_and_cg1_differs() {
@@ -316,7 +313,7 @@ fn converging_global_solvers_agree_and_cg1_differs() {
     for solver in [SolverKind::Cg, SolverKind::Ldlt, SolverKind::Jacobi] {
         let d = max_difference(&run(solver, 1.0), &reference);
         assert!(
-            d <= 1e-5 * size,
+            d <= 1e-12 * size,
             "{} after {STEPS} steps: max |Δx| = {d:e} m vs jacobi1 (size {size} m)",
             solver.name()
         );

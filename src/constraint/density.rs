@@ -2,7 +2,6 @@
 //! XSPH filter over the same members, and the weights and memberships of the projection
 //! (docs/method.md §2.3, §2.5, §3.1).
 
-use super::single::double_offsets;
 use super::stencil::{Members, SCRATCH, Scratch, members_sum, padded};
 use super::{DensityConstraint, Neighborhood};
 use crate::Vec3;
@@ -36,17 +35,11 @@ impl DensityConstraint {
         self.mass * (k.w_zero() + fluid) + boundary + self.walls_at(xi, nb.walls).density
     }
 
-    /// Fills `m` with the fluid members of stencil i, their offsets x_i − x_j (m) given by
-    /// `offset(j)` for neighbour j: the offsets, their lengths (m), and their kernel values W
-    /// (1/m³) in `m.values`, in single precision (docs/method.md §2.5, "Precision").
+    /// Fills `m` with the fluid members of stencil i, particle i at `xi` and its neighbours
+    /// at `x`: their offsets x_i − x_j and distances (m), and their kernel values W (1/m³)
+    /// in `m.values`.
     #[inline(always)]
-    fn fill_members(
-        &self,
-        i: usize,
-        offset: impl Fn(u32) -> [f32; 3],
-        nb: &Neighborhood,
-        m: &mut Members,
-    ) {
+    fn fill_members(&self, i: usize, xi: Vec3, x: &[Vec3], nb: &Neighborhood, m: &mut Members) {
         let k = &self.kernel;
         let neighbors = nb.fluid.of(i);
         m.resize(neighbors.len());
@@ -56,7 +49,8 @@ impl DensityConstraint {
             .zip(&mut m.ry)
             .zip(&mut m.rz)
         {
-            [*rx, *ry, *rz] = offset(j);
+            let xj = &x[j as usize];
+            (*rx, *ry, *rz) = (xi.x - xj.x, xi.y - xj.y, xi.z - xj.z);
         }
         for ((((len, w), rx), ry), rz) in m.len[..padded(m.n)]
             .iter_mut()
@@ -66,26 +60,25 @@ impl DensityConstraint {
             .zip(&m.rz)
         {
             *len = (rx * rx + ry * ry + rz * rz).sqrt();
-            *w = k.w_f32(*len);
+            *w = k.w(*len);
         }
     }
 
-    /// [`Self::density_at`] at the iterate (`xi` = x_i, the fluid members' offsets x_i − x_j
-    /// given by `offset(j)`), keeping every member's offset and distance in `scratch` for
-    /// [`Self::first_gradients`]. The same density up to the order of the summation and the
-    /// rounding of the pair geometry to single precision.
+    /// [`Self::density_at`] at the iterate (`xi` = x_i, neighbours at `x`), keeping every
+    /// member's offset and distance in `scratch` for [`Self::first_gradients`]. The same
+    /// density up to the order of the summation.
     #[inline(always)]
     pub(super) fn first_density(
         &self,
         i: usize,
         xi: Vec3,
-        offset: impl Fn(u32) -> [f32; 3],
+        x: &[Vec3],
         nb: &Neighborhood,
         scratch: &mut Scratch,
     ) -> f64 {
         let k = &self.kernel;
         let m = &mut scratch.members;
-        self.fill_members(i, offset, nb, m);
+        self.fill_members(i, xi, x, nb, m);
         let fluid = members_sum(&m.values, m.n);
         let walls = nb.boundary.of(i);
         let bm = &mut scratch.boundary;
@@ -101,9 +94,8 @@ impl DensityConstraint {
             .zip(&mut bm.psi)
         {
             let b = b as usize;
-            let r = (xi.x - bx[b], xi.y - by[b], xi.z - bz[b]);
-            (*rx, *ry, *rz) = (r.0 as f32, r.1 as f32, r.2 as f32);
-            *psi = bpsi[b] as f32;
+            (*rx, *ry, *rz) = (xi.x - bx[b], xi.y - by[b], xi.z - bz[b]);
+            *psi = bpsi[b];
         }
         for (((((len, w), rx), ry), rz), psi) in bm.len[..padded(bm.n)]
             .iter_mut()
@@ -114,7 +106,7 @@ impl DensityConstraint {
             .zip(&bm.psi)
         {
             *len = (rx * rx + ry * ry + rz * rz).sqrt();
-            *w = psi * k.w_f32(*len);
+            *w = psi * k.w(*len);
         }
         scratch.wall_at = xi;
         scratch.wall = self.walls_at(xi, nb.walls);
@@ -130,7 +122,7 @@ impl DensityConstraint {
     }
 
     crate::simd::avx2_dispatch! {
-        /// ρ_i (kg/m³) with the particles at `x`, by [`Self::first_density`] (eight lanes
+        /// ρ_i (kg/m³) with the particles at `x`, by [`Self::first_density`] (four lanes
         /// wide in the AVX2 build, bitwise alike).
         fn density_of / density_of_avx2(
             &self,
@@ -150,7 +142,7 @@ impl DensityConstraint {
         nb: &Neighborhood,
         scratch: &mut Scratch,
     ) -> f64 {
-        self.first_density(i, x[i], double_offsets(x, x[i]), nb, scratch)
+        self.first_density(i, x[i], x, nb, scratch)
     }
 
     /// The XSPH-filtered velocity of fluid particle i (m/s), docs/method.md §1.3:
@@ -168,7 +160,7 @@ impl DensityConstraint {
 
     crate::simd::avx2_dispatch! {
         /// [`Self::xsph_velocity`] with the thread's buffers; the AVX2 build evaluates the
-        /// kernel eight lanes wide, bitwise alike (tested).
+        /// kernel four lanes wide, bitwise alike (tested).
         fn xsph_into / xsph_into_avx2(
             &self,
             c: f64,
@@ -189,7 +181,7 @@ impl DensityConstraint {
         nb: &Neighborhood,
         members: &mut Members,
     ) -> Vec3 {
-        self.fill_members(i, double_offsets(x, x[i]), nb, members);
+        self.fill_members(i, x[i], x, nb, members);
         let vi = v[i];
         let sum: Vec3 = nb
             .fluid
@@ -198,7 +190,7 @@ impl DensityConstraint {
             .zip(&members.values)
             .map(|(&j, w)| {
                 let j = j as usize;
-                (v[j] - vi) * (volumes[j] * f64::from(*w))
+                (v[j] - vi) * (volumes[j] * w)
             })
             .sum();
         vi + sum * c

@@ -18,11 +18,11 @@ impl DensityConstraint {
         scratch: &mut Scratch,
     ) -> (Vec3, f64) {
         let kernel = &self.kernel;
-        let scale = (self.mass / self.rest_density) as f32;
+        let scale = self.mass / self.rest_density;
         let bm = &mut scratch.boundary;
         let lanes = padded(bm.n);
         for ((c, len), psi) in bm.values[..lanes].iter_mut().zip(&bm.len).zip(&bm.psi) {
-            *c = kernel.grad_w_coefficient_f32(*len) * psi;
+            *c = kernel.grad_w_coefficient(*len) * psi;
         }
         let boundary = (Vec3::new(
             ordered_dot(&bm.rx[..lanes], &bm.values),
@@ -41,12 +41,12 @@ impl DensityConstraint {
             .zip(m.rz.iter().zip(&m.len))
         {
             // ∇_{x_j}C_i = −(m/ρ0)∇W(x_i − x_j).
-            let c = -kernel.grad_w_coefficient_f32(*len) * scale;
+            let c = -kernel.grad_w_coefficient(*len) * scale;
             (*gx, *gy, *gz) = (rx * c, ry * c, rz * c);
             *g2 = *gx * *gx + *gy * *gy + *gz * *gz;
         }
         for (w, &j) in m.weights.iter_mut().zip(nb.fluid.of(i)) {
-            *w = self.weight_of(nb, j as usize) as f32;
+            *w = self.weight_of(nb, j as usize);
         }
         let n = m.n;
         let fluid = Vec3::new(
@@ -71,8 +71,6 @@ impl DensityConstraint {
     ) -> f64 {
         let k = &self.kernel;
         let m = &mut scratch.members;
-        // The members' offsets are in single precision (docs/method.md §2.5, "Precision").
-        let (lambda_f32, s) = (lambda as f32, shift.cast::<f32>());
         for ((((((w, weight), gx), gy), gz), rx), (ry, rz)) in m.values[..padded(m.n)]
             .iter_mut()
             .zip(&m.weights)
@@ -82,9 +80,13 @@ impl DensityConstraint {
             .zip(&m.rx)
             .zip(m.ry.iter().zip(&m.rz))
         {
-            let f = lambda_f32 * weight;
-            let (dx, dy, dz) = (rx + s.x - gx * f, ry + s.y - gy * f, rz + s.z - gz * f);
-            *w = k.w_f32((dx * dx + dy * dy + dz * dz).sqrt());
+            let f = lambda * weight;
+            let (dx, dy, dz) = (
+                rx + shift.x - gx * f,
+                ry + shift.y - gy * f,
+                rz + shift.z - gz * f,
+            );
+            *w = k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
         let fluid = members_sum(&m.values, m.n);
         let bm = &mut scratch.boundary;
@@ -95,8 +97,8 @@ impl DensityConstraint {
             .zip(&bm.rz)
             .zip(&bm.psi)
         {
-            let (dx, dy, dz) = (rx + s.x, ry + s.y, rz + s.z);
-            *w = psi * k.w_f32((dx * dx + dy * dy + dz * dz).sqrt());
+            let (dx, dy, dz) = (rx + shift.x, ry + shift.y, rz + shift.z);
+            *w = psi * k.w((dx * dx + dy * dy + dz * dz).sqrt());
         }
         let walls = self.walls_at(scratch.wall_at + shift, nb.walls).density;
         self.mass * (k.w_zero() + fluid) + members_sum(&bm.values, bm.n) + walls
@@ -155,7 +157,6 @@ impl DensityConstraint {
 
 #[cfg(test)]
 mod tests {
-    use crate::constraint::single::double_offsets;
     use crate::constraint::stencil::Scratch;
     use crate::constraint::test_cluster::{cluster, test_constraint};
     use crate::constraint::{CONSTRAINT_GOAL, REGULARIZATION};
@@ -181,8 +182,7 @@ mod tests {
             let (x, nb) = (&cluster.x, cluster.nb());
             let (mut active, mut certified) = (0, 0);
             for i in 0..x.len() {
-                let rho =
-                    constraint.first_density(i, x[i], double_offsets(x, x[i]), &nb, &mut scratch);
+                let rho = constraint.first_density(i, x[i], x, &nb, &mut scratch);
                 let c = (rho / constraint.rest_density - 1.0).max(0.0);
                 if c <= CONSTRAINT_GOAL {
                     continue;

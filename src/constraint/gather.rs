@@ -2,7 +2,6 @@
 //! step made to it, from the λ_i of single-step projections and the kept segments of the
 //! others ([`Corrections`]), gathered from the particle's side (docs/method.md §2.5, §6).
 
-use super::single::{SinglePositions, double_offsets, single_offsets};
 use super::stencil::{ordered_dot, pad_each, padded_room};
 use super::{DensityConstraint, Neighborhood, Projection};
 use crate::Vec3;
@@ -31,9 +30,6 @@ pub struct Corrections {
     /// Whether particle j is a member of a stencil whose projection kept a segment: only
     /// then does its gather look for segments.
     pub(super) near_kept: Vec<bool>,
-    /// The iterate the local step projected, in single precision: the gather reads the
-    /// gradients' offsets from it as the projections did.
-    pub(super) single: SinglePositions,
     /// Tests refuse segments of more entries than this, as a shortage of memory would.
     #[cfg(test)]
     pub(crate) segment_limit: Option<usize>,
@@ -83,16 +79,15 @@ impl Corrections {
 
 /// Per-thread buffers of one gather ([`DensityConstraint::gathered_corrections`]): the
 /// neighbours whose projection moved the particle, their λ (m²), offsets x_j − x_i (m) by
-/// component, and λ times the kernel's gradient coefficient (1/m³), the last four in single
-/// precision (docs/method.md §2.5, "Precision").
+/// component, and λ times the kernel's gradient coefficient (1/m³).
 #[derive(Default)]
 struct Gather {
     ids: Vec<u32>,
-    lambdas: Vec<f32>,
-    rx: Vec<f32>,
-    ry: Vec<f32>,
-    rz: Vec<f32>,
-    factors: Vec<f32>,
+    lambdas: Vec<f64>,
+    rx: Vec<f64>,
+    ry: Vec<f64>,
+    rz: Vec<f64>,
+    factors: Vec<f64>,
 }
 
 impl Gather {
@@ -160,7 +155,7 @@ impl DensityConstraint {
 
     crate::simd::avx2_dispatch! {
         /// [`Self::gathered_corrections`] with the thread's buffers; the AVX2 build evaluates
-        /// the gradients eight lanes wide, bitwise alike (tested).
+        /// the gradients four lanes wide, bitwise alike (tested).
         fn gather_into / gather_into_avx2(
             &self,
             j: usize,
@@ -175,8 +170,8 @@ impl DensityConstraint {
     /// The body of [`Self::gathered_corrections`]. A first pass lists, without branches and
     /// from one byte per particle, the neighbours i whose single-step projection moved j
     /// (λ_i ≠ 0; about a quarter of them in a flow, in no predictable order); a second reads
-    /// their λ_i and offsets, and a third evaluates their λ_i∇W(x_j − x_i) by component, in
-    /// single precision, eight at a time. Kept segments are read apart (rare).
+    /// their λ_i and offsets, and a third evaluates their λ_i∇W(x_j − x_i) by component, four
+    /// at a time. Kept segments are read apart (rare).
     #[inline(always)]
     fn gathered_correction_portable(
         &self,
@@ -197,11 +192,36 @@ impl DensityConstraint {
             ids[active] = i;
             active += usize::from(corrections.moved[i as usize]);
         }
-        let moved = match corrections.single.points() {
-            Some(points) => self.moved_by(active, single_offsets(points, j), corrections, gather),
-            None => self.moved_by(active, double_offsets(x, x[j]), corrections, gather),
-        };
+        let g = gather;
+        let xj = x[j];
+        for ((((&i, lambda), rx), ry), rz) in g.ids[..active]
+            .iter()
+            .zip(&mut g.lambdas)
+            .zip(&mut g.rx)
+            .zip(&mut g.ry)
+            .zip(&mut g.rz)
+        {
+            *lambda = corrections.lambdas[i as usize];
+            let xi = &x[i as usize];
+            (*rx, *ry, *rz) = (xj.x - xi.x, xj.y - xi.y, xj.z - xi.z);
+        }
+        for ((((f, lambda), rx), ry), rz) in g.factors[..active]
+            .iter_mut()
+            .zip(&g.lambdas)
+            .zip(&g.rx)
+            .zip(&g.ry)
+            .zip(&g.rz)
+        {
+            let len = (rx * rx + ry * ry + rz * rz).sqrt();
+            *f = self.kernel.grad_w_coefficient(len) * lambda;
+        }
+        let (f, n) = (&g.factors[..active], active);
         // λ_i w_j ∇_{x_j}C_i with ∇_{x_j}C_i = (m/ρ0)∇W(x_j − x_i), w_j and m/ρ0 common.
+        let moved = Vec3::new(
+            ordered_dot(&g.rx[..n], f),
+            ordered_dot(&g.ry[..n], f),
+            ordered_dot(&g.rz[..n], f),
+        );
         let scale = self.weight_of(nb, j) * self.mass / self.rest_density;
         let mut sum = projections[j].self_correction + moved * scale;
         if corrections.near_kept[j] {
@@ -212,43 +232,5 @@ impl DensityConstraint {
             }
         }
         sum
-    }
-
-    /// Σ_i λ_i∇W(x_j − x_i) (1/m²) over the first `active` neighbours i listed in
-    /// `g.ids`, their offsets x_j − x_i (m) given by `offset(i)`.
-    #[inline(always)]
-    fn moved_by(
-        &self,
-        active: usize,
-        offset: impl Fn(u32) -> [f32; 3],
-        corrections: &Corrections,
-        g: &mut Gather,
-    ) -> Vec3 {
-        for ((((&i, lambda), rx), ry), rz) in g.ids[..active]
-            .iter()
-            .zip(&mut g.lambdas)
-            .zip(&mut g.rx)
-            .zip(&mut g.ry)
-            .zip(&mut g.rz)
-        {
-            *lambda = corrections.lambdas[i as usize] as f32;
-            [*rx, *ry, *rz] = offset(i);
-        }
-        for ((((f, lambda), rx), ry), rz) in g.factors[..active]
-            .iter_mut()
-            .zip(&g.lambdas)
-            .zip(&g.rx)
-            .zip(&g.ry)
-            .zip(&g.rz)
-        {
-            let len = (rx * rx + ry * ry + rz * rz).sqrt();
-            *f = self.kernel.grad_w_coefficient_f32(len) * lambda;
-        }
-        let f = &g.factors[..active];
-        Vec3::new(
-            ordered_dot(&g.rx[..active], f),
-            ordered_dot(&g.ry[..active], f),
-            ordered_dot(&g.rz[..active], f),
-        )
     }
 }

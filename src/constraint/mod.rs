@@ -10,12 +10,10 @@ mod density;
 mod first_step;
 mod gather;
 mod projection;
-mod single;
 mod stencil;
 
 pub use gather::Corrections;
 pub use projection::Projection;
-pub(crate) use single::SINGLE_PRECISION_REACH;
 
 use crate::Vec3;
 use crate::boundary::{WallContribution, WallField};
@@ -62,9 +60,9 @@ const NEWTON_STEP_LIMIT: f64 = 0.25;
 /// Regularisation ε of λ = −C/(|∇C|² + ε), in m⁻².
 const REGULARIZATION: f64 = 1e-6;
 /// The bound on ρ_i after a first projection step must stay this far (relative to ρ0) below
-/// ρ0 for the step's density to go unevaluated: ten times the rounding of that density in
-/// single precision (docs/method.md §2.5, "Precision").
-const RELAXATION_MARGIN: f64 = 1e-5;
+/// ρ0 for the step's density to go unevaluated: far more than the round-off of either
+/// evaluation (≈ 10⁻¹⁴).
+const RELAXATION_MARGIN: f64 = 1e-9;
 
 /// Everything a constraint reads during one time step: the fluid's neighbour lists, the
 /// static boundary particles with their Akinci masses ψ_b = ρ0·V_b (kg), and the container
@@ -113,10 +111,6 @@ pub struct DensityConstraint {
     /// Evaluate ρ_i after every first projection step, also where a bound already shows it
     /// is below ρ0 (for the test that skipping those evaluations changes nothing).
     pub(crate) evaluate_first_step: bool,
-    /// How far from the iterate's centre, in support radii H, the local step and the gather
-    /// read the fluid members' offsets from a single-precision copy of the iterate
-    /// ([`SINGLE_PRECISION_REACH`]; 0 in tests of the double-precision offsets).
-    pub(crate) single_precision_reach: f64,
 }
 
 impl DensityConstraint {
@@ -228,7 +222,6 @@ mod test_cluster {
             materialize_all: false,
             portable: true,
             evaluate_first_step: true,
-            single_precision_reach: SINGLE_PRECISION_REACH,
         }
     }
 }

@@ -2,7 +2,6 @@
 //! stencil (docs/method.md §2.5), and what each projection produced ([`Projection`]).
 
 use super::gather::Corrections;
-use super::single::{Iterate, double_offsets, single_offsets};
 use super::stencil::{SCRATCH, Scratch};
 use super::{
     CHUNK, CONSTRAINT_GOAL, DensityConstraint, MAX_PROJECTION_STEPS, NEWTON_STEP_LIMIT,
@@ -35,9 +34,7 @@ impl DensityConstraint {
     /// (the usual case) keep only λ_i; longer ones write their stencil corrections
     /// P_{i,j} − x_j (m) into `corrections`: once all constraints are projected, the few
     /// multi-step ones are projected again into segments sized for them alone (a projection
-    /// is a pure function of `x`, so the second pass repeats the first bit for bit). The
-    /// iterate is first copied to single precision for the pair geometry of the first steps
-    /// and the gather (docs/method.md §2.5, "Precision").
+    /// is a pure function of `x`, so the second pass repeats the first bit for bit).
     ///
     /// Errors when memory for the projections or the kept segments cannot be had; the
     /// projections and corrections are then incomplete (a step that fails is undone). The
@@ -51,12 +48,6 @@ impl DensityConstraint {
         corrections: &mut Corrections,
     ) -> Result<(), TryReserveError> {
         let c = corrections;
-        let reach = self.single_precision_reach * self.kernel.support_radius();
-        c.single.update(x, reach)?;
-        let iterate = Iterate {
-            x,
-            single: c.single.points(),
-        };
         reserve_total(projections, x.len())?;
         reserve_total(&mut c.lambdas, x.len())?;
         reserve_total(&mut c.moved, x.len())?;
@@ -81,8 +72,7 @@ impl DensityConstraint {
                         if dp.len() < members {
                             dp.resize(members, Vec3::zeros());
                         }
-                        *lambda =
-                            self.project_one(i, iterate, nb, &mut dp[..members], out, scratch);
+                        *lambda = self.project_one(i, x, nb, &mut dp[..members], out, scratch);
                         *moved = u8::from(*lambda != 0.0 && !out.materialized);
                         kept += usize::from(out.materialized);
                     }
@@ -135,7 +125,7 @@ impl DensityConstraint {
         par_segments_zip_mut(&c.offsets, &mut c.data, &mut c.owners, |_, dp, &mut i| {
             let mut again = Projection::default();
             SCRATCH.with_borrow_mut(|scratch| {
-                self.project_one(i as usize, iterate, nb, dp, &mut again, scratch)
+                self.project_one(i as usize, x, nb, dp, &mut again, scratch)
             });
         })
     }
@@ -205,14 +195,12 @@ impl DensityConstraint {
         /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14; returns the first step's λ
         /// (m², 0 for an inactive constraint). A projection that ends after its first step
         /// is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour)
-        /// receive the corrections. The first step reads the fluid members' offsets from
-        /// the iterate in single precision, where the local step made it (docs/method.md
-        /// §2.5, "Precision"), and from the iterate in double precision otherwise. The AVX2 build runs
-        /// the loops over a stencil's members eight lanes wide, bitwise alike (tested).
+        /// receive the corrections. The AVX2 build runs the loops over a stencil's members
+        /// four lanes wide, bitwise alike (tested).
         fn project_one / project_one_avx2(
             &self,
             i: usize,
-            iterate: Iterate,
+            x: &[Vec3],
             nb: &Neighborhood,
             dp: &mut [Vec3],
             out: &mut Projection,
@@ -225,7 +213,7 @@ impl DensityConstraint {
     fn project_one_portable(
         &self,
         i: usize,
-        Iterate { x, single }: Iterate,
+        x: &[Vec3],
         nb: &Neighborhood,
         dp: &mut [Vec3],
         out: &mut Projection,
@@ -245,12 +233,7 @@ impl DensityConstraint {
             }
             let pi = x[i] + out.self_correction;
             let rho = match (step, materialized) {
-                (0, _) => match single {
-                    Some(points) => {
-                        self.first_density(i, pi, single_offsets(points, i), nb, scratch)
-                    }
-                    None => self.first_density(i, pi, double_offsets(x, pi), nb, scratch),
-                },
+                (0, _) => self.first_density(i, pi, x, nb, scratch),
                 (_, true) => self.density_at(i, pi, |s| at(s) + dp[s + 1], nb),
                 // After the first step p_j = x_j + λ w_j ∇_{p_j}C_i (λ kept, not written out).
                 (_, false) => {
@@ -266,7 +249,7 @@ impl DensityConstraint {
                 dp[0] = out.self_correction;
                 let m = &scratch.members;
                 for (s, w) in m.weights[..m.n].iter().enumerate() {
-                    dp[s + 1] = m.gradient(s) * (first_lambda * f64::from(*w));
+                    dp[s + 1] = m.gradient(s) * (first_lambda * w);
                 }
                 materialized = true;
             }

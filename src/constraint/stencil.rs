@@ -1,6 +1,6 @@
-//! Stencil storage: the members of one projection by component, in single-precision arrays
-//! padded to a multiple of [`LANES`] entries, the per-thread buffers that hold them, and sums
-//! over them in one fixed order (docs/method.md §2.5, "Precision").
+//! Stencil storage: the members of one projection by component, in arrays padded to whole
+//! vectors of [`LANES`] lanes, the per-thread buffers that hold them, and sums over them in
+//! one fixed order.
 
 use crate::Vec3;
 use crate::boundary::WallContribution;
@@ -9,15 +9,12 @@ use std::cell::RefCell;
 use std::collections::TryReserveError;
 
 /// A stencil's members are kept in arrays padded to a multiple of this many entries, so
-/// that every loop over them runs in whole vectors of four or eight lanes.
+/// that every loop over them runs in whole vectors of four lanes with no remainder.
 const LANES: usize = 4;
 /// The offset (m) of a padding member from its stencil's centre: far outside any kernel
 /// support, so its kernel value, gradient and weight are exactly 0 (and, being finite,
-/// 0 times it stays 0; its square stays finite in single precision).
-const FAR: f32 = 1e10;
-/// The sums over a stencil's members run in this many interleaved partial sums: one vector
-/// of single-precision lanes.
-const PARTIALS: usize = 8;
+/// 0 times it stays 0).
+const FAR: f64 = 1e10;
 
 /// Per-thread buffers of one projection: its corrections when they are not kept; its fluid
 /// members ([`Members`]) and boundary members ([`BoundaryMembers`]) at the iterate, both kept
@@ -88,12 +85,12 @@ impl Scratch {
 pub(super) struct BoundaryMembers {
     /// The number of members; the arrays are used up to [`padded`]`(n)`.
     pub(super) n: usize,
-    pub(super) rx: Vec<f32>,
-    pub(super) ry: Vec<f32>,
-    pub(super) rz: Vec<f32>,
-    pub(super) len: Vec<f32>,
-    pub(super) psi: Vec<f32>,
-    pub(super) values: Vec<f32>,
+    pub(super) rx: Vec<f64>,
+    pub(super) ry: Vec<f64>,
+    pub(super) rz: Vec<f64>,
+    pub(super) len: Vec<f64>,
+    pub(super) psi: Vec<f64>,
+    pub(super) values: Vec<f64>,
 }
 
 impl BoundaryMembers {
@@ -132,12 +129,12 @@ pub(super) fn padded(n: usize) -> usize {
 /// never shrink, so that stencils of varying size write no new entries.
 #[inline(always)]
 pub(super) fn pad_each<const P: usize, const C: usize>(
-    padding: [(&mut Vec<f32>, f32); P],
-    computed: [&mut Vec<f32>; C],
+    padding: [(&mut Vec<f64>, f64); P],
+    computed: [&mut Vec<f64>; C],
     n: usize,
 ) {
     let room = padded_room(n);
-    let grow = |v: &mut Vec<f32>| {
+    let grow = |v: &mut Vec<f64>| {
         if v.len() < room {
             v.resize(room, 0.0);
         }
@@ -159,15 +156,15 @@ pub(super) fn pad_each<const P: usize, const C: usize>(
 pub(super) struct Members {
     /// The number of members.
     pub(super) n: usize,
-    pub(super) rx: Vec<f32>,
-    pub(super) ry: Vec<f32>,
-    pub(super) rz: Vec<f32>,
-    pub(super) len: Vec<f32>,
-    pub(super) gx: Vec<f32>,
-    pub(super) gy: Vec<f32>,
-    pub(super) gz: Vec<f32>,
-    pub(super) weights: Vec<f32>,
-    pub(super) values: Vec<f32>,
+    pub(super) rx: Vec<f64>,
+    pub(super) ry: Vec<f64>,
+    pub(super) rz: Vec<f64>,
+    pub(super) len: Vec<f64>,
+    pub(super) gx: Vec<f64>,
+    pub(super) gy: Vec<f64>,
+    pub(super) gz: Vec<f64>,
+    pub(super) weights: Vec<f64>,
+    pub(super) values: Vec<f64>,
 }
 
 impl Members {
@@ -194,70 +191,55 @@ impl Members {
     /// ∇_{x_j}C_i of the s-th member (1/m).
     #[inline]
     pub(super) fn gradient(&self, s: usize) -> Vec3 {
-        Vec3::new(self.gx[s].into(), self.gy[s].into(), self.gz[s].into())
+        Vec3::new(self.gx[s], self.gy[s], self.gz[s])
     }
 }
 
-/// The sum of `values` in one fixed order: [`PARTIALS`] interleaved partial sums in single
-/// precision (so that it vectorises and does not wait on one addition after another), added
-/// up in double precision.
+/// The sum of `values` in one fixed order, in four interleaved partial sums (so that it
+/// vectorises and does not wait on one addition after another).
 #[inline(always)]
-fn ordered_sum(values: &[f32]) -> f64 {
-    let mut partial = [0.0f32; PARTIALS];
-    let chunks = values.chunks_exact(PARTIALS);
-    let rest: f32 = chunks.remainder().iter().sum();
+fn ordered_sum(values: &[f64]) -> f64 {
+    let mut partial = [0.0; 4];
+    let chunks = values.chunks_exact(4);
+    let rest: f64 = chunks.remainder().iter().sum();
     for chunk in chunks {
         for (p, v) in partial.iter_mut().zip(chunk) {
             *p += v;
         }
     }
-    combine(partial) + f64::from(rest)
-}
-
-/// The partial sums of [`ordered_sum`] and [`ordered_dot`] added up pairwise in double
-/// precision.
-#[inline(always)]
-fn combine(partial: [f32; PARTIALS]) -> f64 {
-    let p = partial.map(f64::from);
-    ((p[0] + p[4]) + (p[1] + p[5])) + ((p[2] + p[6]) + (p[3] + p[7]))
+    (partial[0] + partial[1]) + (partial[2] + partial[3]) + rest
 }
 
 /// [`ordered_sum`] of the first [`padded`]`(n)` entries of a padded member array.
 #[inline(always)]
-pub(super) fn members_sum(values: &[f32], n: usize) -> f64 {
+pub(super) fn members_sum(values: &[f64], n: usize) -> f64 {
     ordered_sum(&values[..padded(n)])
 }
 
-/// The sum of `a[k]·b[k]` in one fixed order, in partial sums as [`ordered_sum`]; `b` is at
-/// least as long as `a`.
+/// The sum of `a[k]·b[k]` in one fixed order, in four interleaved partial sums (as
+/// [`ordered_sum`]); `b` is at least as long as `a`.
 #[inline(always)]
-pub(super) fn ordered_dot(a: &[f32], b: &[f32]) -> f64 {
-    let mut partial = [0.0f32; PARTIALS];
-    let (chunks, rest) = (a.chunks_exact(PARTIALS), a.len() / PARTIALS * PARTIALS);
-    let tail: f32 = a[rest..].iter().zip(&b[rest..]).map(|(a, b)| a * b).sum();
-    for (chunk, other) in chunks.zip(b.chunks_exact(PARTIALS)) {
+pub(super) fn ordered_dot(a: &[f64], b: &[f64]) -> f64 {
+    let mut partial = [0.0; 4];
+    let (chunks, rest) = (a.chunks_exact(4), a.len() / 4 * 4);
+    let tail: f64 = a[rest..].iter().zip(&b[rest..]).map(|(a, b)| a * b).sum();
+    for (chunk, other) in chunks.zip(b.chunks_exact(4)) {
         for ((p, a), b) in partial.iter_mut().zip(chunk).zip(other) {
             *p += a * b;
         }
     }
-    combine(partial) + f64::from(tail)
+    (partial[0] + partial[1]) + (partial[2] + partial[3]) + tail
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::constraint::DensityConstraint;
-    use crate::constraint::single::double_offsets;
     use crate::constraint::test_cluster::{cluster, test_constraint};
 
-    /// The relative rounding of a stencil's sums in single precision: a few dozen terms of
-    /// relative error f32::EPSILON each, with room.
-    const SINGLE: f64 = 1e-5;
-
     /// The stencil evaluations that run over padded arrays (densities, the first gradients,
-    /// the XSPH filter) equal direct sums in double precision over every particle of the
-    /// cluster, fluid and boundary, within the support, to the rounding of single precision
-    /// ([`SINGLE`] of the terms' magnitudes): the padding members add nothing. The cluster's stencils
+    /// the XSPH filter) equal direct sums over every particle of the cluster, fluid and
+    /// boundary, within the support: the padding members add nothing. The cluster's stencils
     /// have from a handful to ~40 fluid members and 0 to ~30 boundary members, so every
     /// remainder modulo four occurs, on both the portable and the AVX2 path.
     #[test]
@@ -298,35 +280,32 @@ mod tests {
                         .iter()
                         .map(|&b| psi[b] * k.w((x[i] - bx[b]).norm()))
                         .sum::<f64>();
-                assert!((rho[i] - direct).abs() <= SINGLE * direct, "ρ_{i}");
+                assert!((rho[i] - direct).abs() <= 1e-12 * direct, "ρ_{i}");
 
-                // The gradient's terms cancel: its error is relative to their magnitudes.
-                let fluid_terms = (fluid.iter().filter(|&&j| j != i))
-                    .map(|&j| k.grad_w(&(x[i] - x[j])) * constraint.mass);
-                let wall_terms = walls.iter().map(|&b| k.grad_w(&(x[i] - bx[b])) * psi[b]);
-                let terms: Vec<Vec3> = fluid_terms.chain(wall_terms).collect();
-                let grad_direct = terms.iter().sum::<Vec3>() / constraint.rest_density;
-                let magnitude =
-                    terms.iter().map(|t| t.norm()).sum::<f64>() / constraint.rest_density;
-                constraint.first_density(i, x[i], double_offsets(x, x[i]), &nb, &mut scratch);
+                let grad_direct = (fluid.iter().filter(|&&j| j != i))
+                    .map(|&j| k.grad_w(&(x[i] - x[j])) * constraint.mass)
+                    .sum::<Vec3>()
+                    + walls
+                        .iter()
+                        .map(|&b| k.grad_w(&(x[i] - bx[b])) * psi[b])
+                        .sum::<Vec3>();
+                let grad_direct = grad_direct / constraint.rest_density;
+                constraint.first_density(i, x[i], x, &nb, &mut scratch);
                 let (grad_i, _) = constraint.first_gradients(i, &nb, &mut scratch);
                 assert!(
-                    (grad_i - grad_direct).norm() <= SINGLE * magnitude + 1e-12,
+                    (grad_i - grad_direct).norm() <= 1e-12 * grad_direct.norm().max(1.0),
                     "∇C_{i}: {grad_i:?} against {grad_direct:?}"
                 );
 
-                let xsph_terms: Vec<Vec3> = (fluid.iter())
-                    .map(|&j| {
-                        (v[j] - v[i]) * (constraint.mass / rho[j] * k.w((x[i] - x[j]).norm()))
-                    })
-                    .collect();
-                let xsph_direct = v[i] + xsph_terms.iter().sum::<Vec3>() * 0.1;
-                let xsph_magnitude = xsph_terms.iter().map(|t| t.norm()).sum::<f64>() * 0.1;
+                let xsph_direct = v[i]
+                    + (fluid.iter())
+                        .map(|&j| {
+                            (v[j] - v[i]) * (constraint.mass / rho[j] * k.w((x[i] - x[j]).norm()))
+                        })
+                        .sum::<Vec3>()
+                        * 0.1;
                 let xsph = constraint.xsph_velocity(0.1, i, (x, &v, &volumes), &nb);
-                assert!(
-                    (xsph - xsph_direct).norm() <= SINGLE * xsph_magnitude + 1e-15,
-                    "XSPH v_{i}"
-                );
+                assert!((xsph - xsph_direct).norm() <= 1e-12, "XSPH v_{i}");
             }
             assert!(remainders.iter().all(|&n| n > 0), "{remainders:?}");
         }

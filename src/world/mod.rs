@@ -95,7 +95,6 @@ impl World {
                 materialize_all: false,
                 portable: false,
                 evaluate_first_step: false,
-                single_precision_reach: crate::constraint::SINGLE_PRECISION_REACH,
             },
             pool,
             fluid: Fluid::default(),

@@ -102,10 +102,9 @@ mod step {
             "the scene must exercise the constraint ({active} iterations)"
         );
         for (a, b) in shortcut.positions().iter().zip(reference.positions()) {
-            // The two paths round the pair geometry in single precision in different orders
-            // (docs/method.md §2.5, "Precision"), and round-off differences grow fast in the splashing
-            // flow; a wrong gather would differ by far more than a micrometre.
-            assert!((a - b).norm() <= 1e-6, "{a:?} vs {b:?}");
+            // Round-off differences grow fast in the splashing flow; a wrong gather would
+            // differ by more than a micrometre.
+            assert!((a - b).norm() <= 1e-9, "{a:?} vs {b:?}");
         }
         assert!(compressed > 0.0);
     }
@@ -287,10 +286,9 @@ mod step {
             "no step had some, but not all, projections keep corrections"
         );
         for (a, b) in compact.positions().iter().zip(reference.positions()) {
-            // The two paths round the pair geometry in single precision in different orders
-            // (docs/method.md §2.5, "Precision"), and round-off differences grow fast in the splashing
-            // flow; a wrong gather would differ by far more than a micrometre.
-            assert!((a - b).norm() <= 1e-6, "{a:?} vs {b:?}");
+            // Round-off differences grow fast in the splashing flow; a wrong gather would
+            // differ by more than a micrometre.
+            assert!((a - b).norm() <= 1e-9, "{a:?} vs {b:?}");
         }
     }
 

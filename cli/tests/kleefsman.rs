@@ -71,7 +71,8 @@ fn dam_break_past_a_box_matches_kleefsman_and_discriminates() {
         let rms =
             (pairs.iter().map(|(h, c)| (c - h).powi(2)).sum::<f64>() / pairs.len() as f64).sqrt();
         // A quarter of a spacing: the RMS moves with the rounding alone (runs whose particle
-        // radius differs by 10⁻⁹ of itself read 0.004–0.010 m at the first of these gauges).
+        // radii differ by 10⁻⁹ to 10⁻⁸ of themselves read 0.004–0.010 m at the first of these
+        // gauges).
         assert!(
             rms <= 0.25 * 2.0 * TEST_RADIUS,
             "gauge {g}: content against surface RMS {rms} m"

@@ -617,9 +617,8 @@ enum PfStatus pf_world_add_container_box(struct PfWorld *world,
 /**
  * Adds a closed box container as `pf_world_add_container_box` does, its walls sampled with
  * boundary particles at most `spacing` metres apart, from r/4 to 2r (r is what
- * `pf_world_add_container_box` uses). Walls sampled at 2r hold a quarter of the particles,
- * which made one dam break a tenth faster and another 5 % slower, and read pressures next
- * to them about 3 % high (docs/method.md §7).
+ * `pf_world_add_container_box` uses). Walls sampled at 2r hold a quarter of the particles;
+ * what sparser walls gain and cost depends on the flow (docs/method.md §7).
  *
  * Errors: those of `pf_world_add_container_box`, and `PF_ERROR_INVALID_ARGUMENT` for a
  * spacing outside r/4 to 2r or not finite. On any error no particle is added.
@@ -637,10 +636,9 @@ enum PfStatus pf_world_add_container_box_spaced(struct PfWorld *world,
  * Adds a closed box container from corner `min` to corner `max` (each 3 floats, m) whose
  * six walls are fields rather than particles (docs/method.md §7): each adds to a fluid
  * particle's density, smoothly, what a wall of boundary particles r apart adds on average
- * along it, and costs nothing per boundary particle: a scene's `"walls": "field"`. It read
- * pressures about 4 % high in a tank at rest and let one dam break compress 4.2 % where walls
- * of particles allowed 1.3 % (docs/method.md §7). Fluid farther than r/2 outside every
- * container counts as escaped.
+ * along it, and costs nothing per boundary particle: a scene's `"walls": "field"`. Such
+ * walls have no boundary particles, so `pf_world_boundary_count` does not count them. Fluid
+ * farther than r/2 outside every container counts as escaped.
  *
  * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (non-finite corners, a side
  * shorter than two particle spacings or inverted, a side longer than 10⁵·r),

@@ -272,8 +272,7 @@ pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
 }
 
 /// Default η: an average density error of 0.03 %, the accuracy target itself, which the
-/// density rule holds in every step it ends (docs/method.md §4; docs/performance.md,
-/// "Accuracy per cost").
+/// density rule holds in every step it ends (docs/method.md §4).
 pub const DEFAULT_DENSITY_TOLERANCE: f64 = 3e-4;
 
 /// The default [`Params::warm_start`]: off. A start saves outer iterations but leaves a trace
@@ -291,8 +290,9 @@ pub const DEFAULT_PARTICLE_RADIUS: f64 = 0.025;
 /// (docs/method.md §4); docs/method.md §4 suggests 1e-3.
 pub const DEFAULT_TOLERANCE_PER_RADIUS: f64 = 3e-3;
 
-/// τ of [`Params::calm`] as a multiple of the particle radius: at 3e-4 a settled column moves
-/// at 0.2–0.3 cm/s after 2 s, at 3e-3 still at 1.5–4 cm/s (docs/validation.md, "Tank at rest").
+/// τ of [`Params::calm`] as a multiple of the particle radius, ten times tighter than the
+/// default: a step that stops with its last displacement just under τ leaves a velocity error
+/// of order τ/Δt, which a tank at rest keeps (docs/validation.md, "Tank at rest").
 pub const CALM_TOLERANCE_PER_RADIUS: f64 = 3e-4;
 
 /// The mass factor of SPH codes that take a particle's volume as 0.8·(2r)³ (SPlisHSPlasH

@@ -140,10 +140,9 @@ impl World {
 
     /// Adds a closed container box as [`add_container`](Self::add_container) does, its walls
     /// sampled at most `spacing` (m) apart, from r/4 to 2r. Walls sampled at 2r hold a quarter
-    /// of the boundary particles of walls at r, which made one dam break a tenth faster and
-    /// another 5 % slower, and read pressures next to them about 3 % high
-    /// (docs/method.md §7). Errors, changing nothing, on a spacing outside that range, and
-    /// as `add_container` does.
+    /// of the boundary particles of walls at r; what sparser walls gain and cost depends on
+    /// the flow (docs/method.md §7). Errors, changing nothing, on a spacing outside that
+    /// range, and as `add_container` does.
     pub fn add_container_spaced(
         &mut self,
         container: Aabb,

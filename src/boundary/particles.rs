@@ -82,6 +82,11 @@ impl Boundary {
         self.moving.iter().any(|&m| m)
     }
 
+    /// Whether particle `k` belongs to a moving body.
+    pub fn is_moving_particle(&self, k: usize) -> bool {
+        self.is_moving(self.owner[k])
+    }
+
     fn is_moving(&self, owner: u32) -> bool {
         owner != WALLS && self.moving.get(owner as usize).copied().unwrap_or(false)
     }

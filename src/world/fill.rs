@@ -4,6 +4,7 @@
 
 use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
+use crate::boundary::winding::is_closed_and_oriented;
 use crate::boundary::{
     Aabb, ContainerWalls, MAX_WALL_SPACING, MIN_WALL_SPACING, WALL_SPACING, WALLS, WallField,
     sample_box_walls_into, wall_spacing,
@@ -28,16 +29,28 @@ fn boundary_oom(_: std::collections::TryReserveError) -> Error {
     Error::out_of_memory("boundary particles")
 }
 
+/// The points `at(i, j, k)` for i < count[0], j < count[1], k < count[2], i running fastest.
+fn lattice(
+    count: [usize; 3],
+    at: impl Fn(usize, usize, usize) -> Vec3,
+) -> impl Iterator<Item = Vec3> {
+    (0..count[2])
+        .flat_map(move |k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
+        .map(move |(i, j, k)| at(i, j, k))
+}
+
 impl World {
-    /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`).
-    /// They get the next ids in the order given (see [`World::ids`]). Rejects non-finite
-    /// values, length mismatches, too many particles and ([`Error::OutOfMemory`]) a shortage
-    /// of memory without changing the world.
+    /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`)
+    /// where they do not lie inside a solid (outside every container box, or inside a closed
+    /// obstacle or body), and settles them as [`World::add_fluid_block`] does. Returns how
+    /// many it added; they get the next ids in the order given (see [`World::ids`]). Rejects
+    /// non-finite values, length mismatches, too many particles and
+    /// ([`Error::OutOfMemory`]) a shortage of memory without changing the world.
     pub fn add_fluid_particles(
         &mut self,
         positions: &[Vec3],
         velocities: Option<&[Vec3]>,
-    ) -> Result<(), Error> {
+    ) -> Result<usize, Error> {
         check_finite("positions", positions)?;
         if let Some(v) = velocities {
             if v.len() != positions.len() {
@@ -57,27 +70,42 @@ impl World {
             ));
         }
         self.try_reserve_fluid(positions.len()).map_err(fluid_oom)?;
+        let solids = self.solids();
+        let outside: Vec<bool> = positions.iter().map(|p| !solids.contain(p)).collect();
+        let kept = |k: &usize| outside[*k];
+        let first = self.fluid.next_id;
+        let added = outside.iter().filter(|&&o| o).count();
+        let at = (0..positions.len()).filter(kept).map(|k| positions[k]);
         match velocities {
-            Some(v) => self.fluid.push(positions, v.iter().copied()),
-            None => self.fluid.push(
-                positions,
-                std::iter::repeat_n(Vec3::zeros(), positions.len()),
-            ),
+            Some(v) => self
+                .fluid
+                .extend(at, (0..v.len()).filter(kept).map(|k| v[k])),
+            None => self
+                .fluid
+                .extend(at, std::iter::repeat_n(Vec3::zeros(), added)),
         }
-        Ok(())
+        self.settle_new_fluid(first);
+        self.last_added = added;
+        Ok(added)
     }
 
     /// Adds a cubic lattice of fluid particles with spacing 2r: centres at
-    /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with `velocity`.
-    /// They get the next ids with i running fastest, then j, then k. Errors, changing
-    /// nothing, on a zero or absurd count, a non-finite lattice, or ([`Error::OutOfMemory`])
-    /// a shortage of memory; the lattice is written straight into the particle storage.
+    /// `start + 2r·(i, j, k)` for i < count[0], j < count[1], k < count[2], all moving with
+    /// `velocity`, except those inside a solid (outside every container box, or inside a
+    /// closed obstacle or body), which are not created. Returns how many it added; they get
+    /// the next ids with i running fastest, then j, then k.
+    ///
+    /// The new particles start calm wherever they are put (docs/method.md §2.7): those nearer
+    /// than r to a container wall are moved out to r, and what they compress against walls,
+    /// obstacles, bodies or fluid already there is projected away on their positions, not
+    /// turned into velocity. Errors, changing nothing, on a zero or absurd count, a non-finite
+    /// lattice, or ([`Error::OutOfMemory`]) a shortage of memory.
     pub fn add_fluid_block(
         &mut self,
         start: Vec3,
         count: [usize; 3],
         velocity: Vec3,
-    ) -> Result<(), Error> {
+    ) -> Result<usize, Error> {
         let total = count.iter().try_fold(1usize, |acc, &c| acc.checked_mul(c));
         match total {
             Some(n) if n > 0 && n <= MAX_PARTICLES => {}
@@ -104,11 +132,15 @@ impl World {
             ));
         }
         self.try_reserve_fluid(n).map_err(fluid_oom)?;
-        let lattice = (0..count[2])
-            .flat_map(|k| (0..count[1]).flat_map(move |j| (0..count[0]).map(move |i| (i, j, k))))
-            .map(move |(i, j, k)| at(i, j, k));
-        self.fluid.extend(lattice, std::iter::repeat_n(velocity, n));
-        Ok(())
+        let solids = self.solids();
+        let added = lattice(count, at).filter(|p| !solids.contain(p)).count();
+        let first = self.fluid.next_id;
+        let kept = lattice(count, at).filter(|p| !solids.contain(p));
+        self.fluid
+            .extend(kept, std::iter::repeat_n(velocity, added));
+        self.settle_new_fluid(first);
+        self.last_added = added;
+        Ok(added)
     }
 
     /// Adds static boundary particles at `positions` (m). Rejects non-finite values, too many
@@ -313,6 +345,14 @@ impl World {
         }
         crate::reserve::probe(bound * MESH_SAMPLING_BYTES).map_err(boundary_oom)?;
         let samples = sample_poisson_disk(mesh, r);
-        self.add_boundary_particles(&samples)
+        let closed = is_closed_and_oriented(mesh);
+        self.obstacles
+            .try_reserve(usize::from(closed))
+            .map_err(boundary_oom)?;
+        self.add_boundary_particles(&samples)?;
+        if closed {
+            self.obstacles.push(mesh.clone());
+        }
+        Ok(())
     }
 }

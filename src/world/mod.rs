@@ -8,6 +8,7 @@
 mod bodies;
 mod emitters;
 mod fill;
+mod placement;
 mod read;
 mod sinks;
 mod snapshot;
@@ -23,6 +24,7 @@ pub(crate) use snapshot::Snapshot;
 pub use state::{GridParts, WorldState};
 
 use crate::body::Body;
+use crate::boundary::mesh::TriangleMesh;
 use crate::boundary::{Aabb, Boundary};
 use crate::constraint::{DensityConstraint, MEMBERSHIP_FLOOR};
 use crate::emitter::Emitter;
@@ -44,6 +46,11 @@ pub struct World {
     pub(crate) boundary: Boundary,
     /// Container boxes; fluid outside all of them counts as escaped.
     pub(crate) containers: Vec<Aabb>,
+    /// How many fluid particles the last call that adds fluid made (the rest lay inside a
+    /// solid).
+    pub(crate) last_added: usize,
+    /// The static obstacles' meshes that are closed, whose inside no fluid is placed in.
+    pub(crate) obstacles: Vec<TriangleMesh>,
     /// Sink boxes: fluid in them at the end of a step is removed.
     pub(crate) sinks: Vec<Aabb>,
     /// Fluid outside the domain at the end of a step is removed.
@@ -100,6 +107,8 @@ impl World {
             fluid: Fluid::default(),
             boundary: Boundary::default(),
             containers: Vec::new(),
+            obstacles: Vec::new(),
+            last_added: 0,
             sinks: Vec::new(),
             domain: None,
             emitters: Vec::new(),
@@ -174,6 +183,13 @@ impl World {
     /// Number of fluid particles.
     pub fn fluid_count(&self) -> usize {
         self.fluid.positions.len()
+    }
+
+    /// How many fluid particles the last [`World::add_fluid_block`] or
+    /// [`World::add_fluid_particles`] made: those asked for less the ones that lay inside a
+    /// solid (0 before any such call).
+    pub fn last_added_count(&self) -> usize {
+        self.last_added
     }
 
     /// Number of boundary particles.

@@ -53,50 +53,89 @@ impl Snapshot {
     }
 }
 
+/// `points` (m) held by component.
+fn points_by_component(points: &[Vec3]) -> PointsByComponent {
+    let mut out = PointsByComponent::default();
+    out.fill(points).expect(OUT_OF_MEMORY);
+    out
+}
+
 impl World {
     /// The fluid and boundary particles sorted into a fresh grid, or `None` when there are
     /// none. Runs on the caller's thread pool (call it inside the world's). Before the first
     /// step the boundary has no masses yet; they are then computed here as the step would,
     /// over the boundary particles there are. Panics when the memory cannot be had.
     pub(crate) fn snapshot(&self) -> Option<Snapshot> {
+        self.snapshot_with(0.0, false)
+    }
+
+    /// [`World::snapshot`] with a grid that reaches `margin` (m) beyond the particles, for
+    /// particles that will move that far; with `bodies`, the moving bodies' particles at
+    /// their current poses join the boundary with their own masses (before the first step
+    /// the boundary does not hold them yet).
+    pub(crate) fn snapshot_with(&self, margin: f64, bodies: bool) -> Option<Snapshot> {
         let h = self.params.support_radius();
         let fluid = &self.fluid.positions;
         let boundary = &self.boundary;
+        let (mut points, known) = if bodies && boundary.has_moving() {
+            let (statics, _) = boundary.statics();
+            let psi = (boundary.psi.len() == boundary.len()).then(|| {
+                (0..boundary.len())
+                    .filter(|&k| !boundary.is_moving_particle(k))
+                    .map(|k| boundary.psi[k])
+                    .collect::<Vec<f64>>()
+            });
+            (statics, psi)
+        } else {
+            let psi = (boundary.psi.len() == boundary.len()).then(|| boundary.psi.clone());
+            (boundary.positions.to_vec(), psi)
+        };
         let bounds = [
             Aabb::around(fluid),
-            Aabb::enclosing(boundary.positions.iter()),
+            Aabb::around(&points),
+            Aabb::enclosing(self.moving_body_particles(bodies).map(|(p, _)| p)),
         ]
         .into_iter()
         .flatten()
         .reduce(|a, b| a.union(&b))?;
-        let grid = UniformGrid::covering(bounds.min, bounds.max, h).expect(OUT_OF_MEMORY);
+        let pad = Vec3::repeat(margin);
+        let grid =
+            UniformGrid::covering(bounds.min - pad, bounds.max + pad, h).expect(OUT_OF_MEMORY);
         let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
         let (mut fluid_order, mut boundary_order) = (Vec::new(), Vec::new());
+        let mut psi = match known.filter(|_| !boundary.dirty) {
+            Some(psi) => psi,
+            None => {
+                // Akinci volumes over the static particles (docs/method.md §2.6).
+                let mut bx = PointsByComponent::default();
+                let mut order = Vec::new();
+                grid.sort(&points, &mut order, &mut boundary_table)
+                    .expect(OUT_OF_MEMORY);
+                bx.try_permuted_from(&points_by_component(&points), &order)
+                    .expect(OUT_OF_MEMORY);
+                let kernel = &self.constraint.kernel;
+                let volumes =
+                    akinci_volumes(&grid, &boundary_table, &bx, kernel).expect(OUT_OF_MEMORY);
+                let mut psi = vec![0.0; points.len()];
+                for (&k, v) in order.iter().zip(volumes) {
+                    psi[k as usize] = v * self.params.rest_density;
+                }
+                psi
+            }
+        };
+        for (p, own) in self.moving_body_particles(bodies) {
+            points.push(p);
+            psi.push(own);
+        }
         grid.sort(fluid, &mut fluid_order, &mut fluid_table)
             .expect(OUT_OF_MEMORY);
-        grid.sort_by_component(
-            &boundary.positions,
-            &mut boundary_order,
-            &mut boundary_table,
-        )
-        .expect(OUT_OF_MEMORY);
+        grid.sort(&points, &mut boundary_order, &mut boundary_table)
+            .expect(OUT_OF_MEMORY);
         let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
         let mut bx = PointsByComponent::default();
-        bx.try_permuted_from(&boundary.positions, &boundary_order)
+        bx.try_permuted_from(&points_by_component(&points), &boundary_order)
             .expect(OUT_OF_MEMORY);
-        let psi = if !boundary.dirty && boundary.psi.len() == bx.len() {
-            boundary_order
-                .iter()
-                .map(|&i| boundary.psi[i as usize])
-                .collect()
-        } else {
-            let kernel = &self.constraint.kernel;
-            akinci_volumes(&grid, &boundary_table, &bx, kernel)
-                .expect(OUT_OF_MEMORY)
-                .into_iter()
-                .map(|v| v * self.params.rest_density)
-                .collect()
-        };
+        let psi = boundary_order.iter().map(|&i| psi[i as usize]).collect();
         Some(Snapshot {
             grid,
             fluid_table,
@@ -107,6 +146,20 @@ impl World {
             psi,
             walls: boundary.walls.clone(),
         })
+    }
+
+    /// With `bodies`, the moving bodies' particles at their current poses (m) with their masses
+    /// ψ (kg); none otherwise.
+    fn moving_body_particles(&self, bodies: bool) -> impl Iterator<Item = (Vec3, f64)> + '_ {
+        self.bodies
+            .iter()
+            .filter(move |b| bodies && b.moves())
+            .flat_map(|b| {
+                b.samples
+                    .iter()
+                    .zip(&b.psi)
+                    .map(move |(s, &psi)| (b.pose.apply(s), psi))
+            })
     }
 
     /// Runs `read` with the neighbourhood of every fluid particle of `snapshot` (its fluid and

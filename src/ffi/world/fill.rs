@@ -139,6 +139,7 @@ fn add_fluid(
     };
     world
         .add_fluid_particles(&positions, velocities.as_deref())
+        .map(|_| ())
         .map_err(|e| renamed(e, "positions", "xyz"))
 }
 

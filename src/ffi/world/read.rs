@@ -53,6 +53,27 @@ pub unsafe extern "C" fn pf_world_fluid_count(world: *const PfWorld, out: *mut u
     })
 }
 
+/// Stores in `*out` how many fluid particles the last `pf_world_add_fluid_box`,
+/// `pf_world_add_fluid_particles` or `pf_world_add_fluid_particles_with_velocities` call
+/// made: those asked for less the ones whose centres lay inside a solid (outside every
+/// container box, or inside a closed obstacle or body), which are not created. 0 before any
+/// such call.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_last_added_count(
+    world: *const PfWorld,
+    out: *mut usize,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_last_added_count", || {
+        let n = args.world(world)?.last_added_count();
+        args.write(out, n, "out")
+    })
+}
+
 /// Stores the number of boundary particles in `*out`.
 ///
 /// # Safety

@@ -1,0 +1,254 @@
+//! Placing fluid where a user puts it (docs/method.md §2.7): particles whose centres lie
+//! inside a solid are not created, those nearer a container wall than one particle radius r
+//! are moved out to r, and what the new particles still compress, against walls, obstacles,
+//! bodies and the fluid already there, is projected away on their positions alone before the
+//! first step, so that no velocity comes of it.
+
+use super::World;
+use super::snapshot::Snapshot;
+use crate::Vec3;
+use crate::boundary::Aabb;
+use crate::boundary::mesh::TriangleMesh;
+use crate::boundary::winding::{is_closed_and_oriented, is_inside};
+use crate::neighbors::NeighborLists;
+use rayon::prelude::*;
+
+/// The placement projection stops once no constraint of the fluid is compressed by more
+/// than this fraction of ρ0: what is left turns into velocities of a few mm/s in the first
+/// step.
+pub(crate) const PLACEMENT_TOLERANCE: f64 = 2e-4;
+
+/// Most passes of the placement projection. Each pass moves compression about one particle
+/// spacing through the fluid; a block pressed into a wall needs some ten.
+const PLACEMENT_PASSES: usize = 400;
+
+/// Share of the summed corrections a pass applies: the constraints of neighbouring particles
+/// overlap, and their full sum overshoots.
+const PLACEMENT_RELAXATION: f64 = 0.5;
+
+/// Longest move of a particle in one pass, in particle radii r.
+const PLACEMENT_STEP: f64 = 0.25;
+
+/// The solids a new fluid particle must not start inside: the container boxes (their
+/// outside) and the closed meshes of obstacles and bodies where they stand now.
+pub(super) struct Solids {
+    containers: Vec<Aabb>,
+    closed: Vec<(TriangleMesh, Aabb)>,
+}
+
+impl Solids {
+    /// Whether a fluid particle centred at `p` (m) would lie inside a solid: outside every
+    /// container box (when there are any), or inside a closed obstacle or body mesh.
+    pub(super) fn contain(&self, p: &Vec3) -> bool {
+        let contained = self.containers.iter().any(|c| c.contains(p, 0.0));
+        (!self.containers.is_empty() && !contained)
+            || self
+                .closed
+                .iter()
+                .any(|(mesh, bounds)| bounds.contains(p, 0.0) && is_inside(mesh, p))
+    }
+}
+
+/// Moves every particle of `positions` (m) that has a holding container in `holders` to at
+/// least `r` (m) from each of its walls (where the box is wide enough for that).
+fn clear_of_walls(positions: &mut [Vec3], holders: &[Option<Aabb>], r: f64) {
+    for (p, holder) in positions.iter_mut().zip(holders) {
+        if let Some(c) = holder {
+            for a in 0..3 {
+                if c.max[a] - c.min[a] > 2.0 * r {
+                    p[a] = p[a].clamp(c.min[a] + r, c.max[a] - r);
+                }
+            }
+        }
+    }
+}
+
+impl World {
+    /// The solids of the world as they stand, for [`Solids::contain`].
+    pub(super) fn solids(&self) -> Solids {
+        let bodies = self
+            .bodies
+            .iter()
+            .filter(|b| is_closed_and_oriented(&b.mesh))
+            .map(|b| b.placed_mesh());
+        let closed = self
+            .obstacles
+            .iter()
+            .cloned()
+            .chain(bodies)
+            .map(|mesh| {
+                let bounds = mesh.bounds();
+                (mesh, bounds)
+            })
+            .collect();
+        Solids {
+            containers: self.containers.clone(),
+            closed,
+        }
+    }
+
+    /// Settles the fluid particles whose ids are `first_id` or later, just added: moves those
+    /// nearer than r to a wall of the container that holds them out to r, then projects the
+    /// density constraints of every particle near them on their positions alone until no
+    /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] (or [`PLACEMENT_PASSES`]
+    /// have run). Velocities and the particles added before stay as they are.
+    ///
+    /// # Panics
+    /// When the memory for the neighbour search cannot be had (as the readings between steps).
+    pub(super) fn settle_new_fluid(&mut self, first_id: u64) {
+        let r = self.params.particle_radius;
+        let holders: Vec<Option<Aabb>> = self
+            .fluid
+            .positions
+            .iter()
+            .zip(&self.fluid.ids)
+            .map(|(p, &id)| {
+                let holder = self.containers.iter().find(|c| c.contains(p, 0.0));
+                holder.filter(|_| id >= first_id).copied()
+            })
+            .collect();
+        clear_of_walls(&mut self.fluid.positions, &holders, r);
+        let settled = self
+            .pool
+            .install(|| self.placement_projection(first_id, &holders));
+        if let Some(settled) = settled {
+            self.fluid.positions = settled;
+        }
+    }
+
+    /// The fluid's positions (m, in storage order) after the passes of
+    /// [`World::settle_new_fluid`]'s projection, or `None` where nothing was compressed.
+    /// Runs on the caller's pool.
+    fn placement_projection(&self, first_id: u64, holders: &[Option<Aabb>]) -> Option<Vec<Vec3>> {
+        let h = self.params.support_radius();
+        let step = PLACEMENT_STEP * self.params.particle_radius;
+        let mut snapshot = self.snapshot_with(h, true)?;
+        let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
+        let mut positions = self.fluid.positions.clone();
+        let rest = self.constraint.rest_density;
+        let (k, m) = (&self.constraint.kernel, self.constraint.mass);
+        let (mut fluid_lists, mut boundary_lists) =
+            (NeighborLists::default(), NeighborLists::default());
+        let mut moved = false;
+        for _ in 0..PLACEMENT_PASSES {
+            let x = &snapshot.fluid;
+            let free: Vec<bool> = snapshot
+                .fluid_order
+                .iter()
+                .map(|&i| movable[i as usize])
+                .collect();
+            snapshot
+                .grid
+                .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists)
+                .expect("memory for the placement's neighbour search");
+            snapshot.boundary_near(x, h, &mut boundary_lists);
+            let lists = (&fluid_lists, &boundary_lists);
+            let lambdas = self.placement_multipliers(&snapshot, lists, &free);
+            let worst = lambdas.iter().map(|l| l.1).fold(0.0, f64::max);
+            if worst <= PLACEMENT_TOLERANCE {
+                break;
+            }
+            moved = true;
+            let moves: Vec<Vec3> = (0..x.len())
+                .into_par_iter()
+                .map(|j| {
+                    if !free[j] {
+                        return Vec3::zeros();
+                    }
+                    let xj = x[j];
+                    let lj = lambdas[j].0;
+                    let mut d = Vec3::zeros();
+                    for &i in fluid_lists.of(j) {
+                        let i = i as usize;
+                        d += (lj + lambdas[i].0) * (m / rest) * k.grad_w(&(xj - x[i]));
+                    }
+                    if lj != 0.0 {
+                        let solid: Vec3 = boundary_lists
+                            .of(j)
+                            .iter()
+                            .map(|&q| {
+                                let q = q as usize;
+                                snapshot.psi[q] * k.grad_w(&(xj - snapshot.boundary.at(q)))
+                            })
+                            .sum();
+                        let walls = self.constraint.walls_at(xj, &snapshot.walls).gradient;
+                        d += lj * (solid + walls) / rest;
+                    }
+                    let d = PLACEMENT_RELAXATION * d;
+                    let len = d.norm();
+                    if len > step { d * (step / len) } else { d }
+                })
+                .collect();
+            for ((p, d), &i) in x.iter().zip(&moves).zip(&snapshot.fluid_order) {
+                positions[i as usize] = p + d;
+            }
+            clear_of_walls(&mut positions, holders, self.params.particle_radius);
+            snapshot
+                .grid
+                .sort(
+                    &positions,
+                    &mut snapshot.fluid_order,
+                    &mut snapshot.fluid_table,
+                )
+                .expect("memory for the placement's sort");
+            let order = &snapshot.fluid_order;
+            snapshot.fluid = order.iter().map(|&i| positions[i as usize]).collect();
+        }
+        moved.then_some(positions)
+    }
+
+    /// For every fluid particle of `snapshot`, the multiplier λ_i of its density constraint's
+    /// projection onto the movable particles (0 where it is not compressed or cannot move
+    /// anything) and its compression C_i (dimensionless).
+    fn placement_multipliers(
+        &self,
+        snapshot: &Snapshot,
+        (fluid_lists, boundary_lists): (&NeighborLists, &NeighborLists),
+        movable: &[bool],
+    ) -> Vec<(f64, f64)> {
+        let k = &self.constraint.kernel;
+        let m = self.constraint.mass;
+        let rest = self.constraint.rest_density;
+        let x = &snapshot.fluid;
+        (0..x.len())
+            .into_par_iter()
+            .map(|i| {
+                let xi = x[i];
+                let near = fluid_lists.of(i);
+                if !movable[i] && !near.iter().any(|&j| movable[j as usize]) {
+                    return (0.0, 0.0);
+                }
+                let mut rho = m * k.w_zero();
+                let mut own = Vec3::zeros();
+                let mut others = 0.0;
+                for &j in near {
+                    let j = j as usize;
+                    let r = xi - x[j];
+                    rho += m * k.w(r.norm());
+                    let g = (m / rest) * k.grad_w(&r);
+                    own += g;
+                    if movable[j] {
+                        others += g.norm_squared();
+                    }
+                }
+                for &q in boundary_lists.of(i) {
+                    let q = q as usize;
+                    let r = xi - snapshot.boundary.at(q);
+                    rho += snapshot.psi[q] * k.w(r.norm());
+                    own += (snapshot.psi[q] / rest) * k.grad_w(&r);
+                }
+                let walls = self.constraint.walls_at(xi, &snapshot.walls);
+                rho += walls.density;
+                own += walls.gradient / rest;
+                let c = (rho / rest - 1.0).max(0.0);
+                let own = if movable[i] { own.norm_squared() } else { 0.0 };
+                let denominator = own + others;
+                if c == 0.0 || denominator <= 0.0 {
+                    (0.0, c)
+                } else {
+                    (-c / (denominator + 1e-6), c)
+                }
+            })
+            .collect()
+    }
+}

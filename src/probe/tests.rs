@@ -66,7 +66,7 @@ fn settled_tank(walls: ContainerWalls) -> &'static Settled {
         let extent = |c: usize| (c - 1) as f64 * d + 2.0 * gap;
         let tank = Aabb {
             min: Vec3::zeros(),
-            max: Vec3::new(extent(8), 1.5 * extent(10), extent(8)),
+            max: Vec3::new(extent(8), 2.0 * extent(10), extent(8)),
         };
         let mut world = World::new(params).unwrap();
         world.add_container_with(tank, walls).unwrap();

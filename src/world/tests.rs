@@ -672,9 +672,9 @@ const CORNER_BOX: Aabb = Aabb {
     max: Vec3::new(0.5, 0.4, 0.3),
 };
 
-/// A 6 × 7 × 5 block of water 1.5r from three walls of [`CORNER_BOX`] (r = 0.02 m, τ = 2e-5
-/// m), with `params` for the rest: closer to the walls than docs/method.md §7 asks, so that
-/// it starts up to 50 % compressed in the corners and its first steps hit K_max.
+/// A 6 × 7 × 5 block of water placed 1.5r from three walls of [`CORNER_BOX`] (r = 0.02 m,
+/// τ = 2e-5 m) and thrown into their corner at 2√3 m/s, with `params` for the rest: its
+/// impact compresses the corner, and its first step hits K_max.
 fn corner_start(params: Params) -> World {
     let params = Params {
         particle_radius: 0.02,
@@ -684,15 +684,15 @@ fn corner_start(params: Params) -> World {
     let mut world = World::new(params).unwrap();
     world.add_container(CORNER_BOX, 1).unwrap();
     world
-        .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::zeros())
+        .add_fluid_block(Vec3::repeat(0.03), [6, 7, 5], Vec3::repeat(-2.0))
         .unwrap();
     world
 }
 
-/// Water placed 1.5r from three walls starts up to 50 % compressed in the corners, and the
-/// first steps hit K_max. There Chebyshev's extrapolation at the default ρ_c = 0.99 threw
-/// corner particles through the walls within the first steps; the step that reaches K_max
-/// starts over without the extrapolation (docs/method.md §4, "Fallback"), which keeps them in.
+/// Water thrown into a corner hits K_max in its first step. There Chebyshev's extrapolation
+/// at the default ρ_c = 0.99 threw corner particles through the walls within the first
+/// steps; the step that reaches K_max starts over without the extrapolation
+/// (docs/method.md §4, "Fallback"), which keeps them in.
 #[test]
 fn a_step_whose_extrapolation_reaches_the_limit_starts_over_without_it() {
     let start = |threads| {
@@ -842,15 +842,17 @@ fn walls_that_are_fields_give_the_density_walls_of_particles_give() {
         max: Vec3::new(12.0, 10.0, 8.0) * d + Vec3::repeat(0.25 * r),
     };
     let densities = |field: bool| {
+        // The fluid first, so that both worlds read it where the lattice put it: fluid added
+        // into a container would be settled against its walls (docs/method.md §2.7).
         let mut world = World::new(Params::default()).unwrap();
+        world
+            .add_fluid_block(Vec3::repeat(d), [11, 9, 7], Vec3::zeros())
+            .unwrap();
         if field {
             world.add_container_field(tank).unwrap();
         } else {
             world.add_container(tank, 1).unwrap();
         }
-        world
-            .add_fluid_block(Vec3::repeat(d), [11, 9, 7], Vec3::zeros())
-            .unwrap();
         assert_eq!(world.boundary_count() == 0, field);
         (world.positions(), world.current_densities())
     };

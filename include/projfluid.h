@@ -8,6 +8,11 @@
  * and pf_last_error_message() explains why. Units are SI (m, s, kg). Particle vectors are
  * flat x, y, z float arrays; rigid bodies' vectors and poses are doubles. One world must not
  * be used from two threads at once; distinct worlds may be used in parallel.
+ *
+ * Tools that read C declarations but cannot run the preprocessor (Python's cffi, LuaJIT's
+ * ffi) take include/projfluid_cdef.h instead: the same declarations, generated with this
+ * header, with no preprocessor lines and PF_ABI_VERSION as an enum constant. See the
+ * "cffi and LuaJIT" section of docs/c-api.md.
  */
 
 #ifndef PROJFLUID_H
@@ -845,6 +850,18 @@ enum PfStatus pf_world_relax(struct PfWorld *world, double seconds, double dampi
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
  */
 enum PfStatus pf_world_fluid_count(const struct PfWorld *world, size_t *out);
+
+/**
+ * Stores in `*out` how many fluid particles the last `pf_world_add_fluid_box`,
+ * `pf_world_add_fluid_particles` or `pf_world_add_fluid_particles_with_velocities` call
+ * made: those asked for less the ones whose centres lay inside a solid (outside every
+ * container box, or inside a closed obstacle or body), which are not created. 0 before any
+ * such call.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_last_added_count(const struct PfWorld *world, size_t *out);
 
 /**
  * Stores the number of boundary particles in `*out`.

@@ -6,8 +6,14 @@ use std::process::Command;
 
 /// Whether `tool --version` runs. Panics under CI when it does not.
 pub fn available(tool: &str) -> bool {
+    available_with(tool, &["--version"])
+}
+
+/// Whether `tool args` runs and succeeds, for tools without `--version` (`luajit -v`).
+/// Panics under CI when it does not.
+pub fn available_with(tool: &str, args: &[&str]) -> bool {
     let found = Command::new(tool)
-        .arg("--version")
+        .args(args)
         .output()
         .is_ok_and(|o| o.status.success());
     if !found {

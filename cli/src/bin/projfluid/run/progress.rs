@@ -2,7 +2,7 @@
 
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use projfluid_lab::driver::{RunLength, StepReport};
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 
 /// Progress on stderr: a bar on a terminal, else a line about every 10 % of the run.
 pub(super) struct Progress {
@@ -15,8 +15,15 @@ pub(super) struct Progress {
 
 impl Progress {
     pub(super) fn new(target: RunLength) -> Self {
-        let bar = std::io::stderr().is_terminal().then(|| {
-            let bar = ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr());
+        let bar = std::io::stderr()
+            .is_terminal()
+            .then(|| ProgressBar::with_draw_target(Some(1000), ProgressDrawTarget::stderr()));
+        Self::with_bar(target, bar)
+    }
+
+    /// Progress shown on `bar` (permille of the run), or as lines on stderr when `None`.
+    fn with_bar(target: RunLength, bar: Option<ProgressBar>) -> Self {
+        if let Some(bar) = &bar {
             let style = ProgressStyle::with_template(
                 "{bar:20.cyan/blue} {percent:>3}% {elapsed:>4} {wide_msg}",
             )
@@ -25,8 +32,7 @@ impl Progress {
             if let RunLength::Steps(n) = target {
                 bar.set_message(format!("0/{n} steps"));
             }
-            bar
-        });
+        }
         Self {
             bar,
             next_tenth: 1,
@@ -70,9 +76,108 @@ impl Progress {
         }
     }
 
+    /// Draws the bar's final state and ends its line on stderr, so that what follows (the
+    /// run's summary) starts on a line of its own.
     pub(super) fn finish(&self) {
+        self.finish_on(&mut std::io::stderr());
+    }
+
+    /// As `finish`, the bar drawing on the terminal that `terminal` writes to.
+    fn finish_on(&self, terminal: &mut impl Write) {
         if let Some(bar) = &self.bar {
             bar.finish();
+            // indicatif leaves the cursor after the bar, on the bar's line, counting on the
+            // terminal to wrap the next character written.
+            let _ = writeln!(terminal);
+            let _ = terminal.flush();
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use indicatif::TermLike;
+    use std::sync::{Arc, Mutex};
+
+    /// A terminal 60 columns wide that records what is written to it; cursor movements
+    /// and clearing are not recorded.
+    #[derive(Clone, Debug, Default)]
+    struct Screen(Arc<Mutex<String>>);
+
+    impl Screen {
+        fn text(&self) -> String {
+            self.0.lock().unwrap().clone()
+        }
+    }
+
+    impl TermLike for Screen {
+        fn width(&self) -> u16 {
+            60
+        }
+        fn move_cursor_up(&self, _: usize) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_down(&self, _: usize) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_right(&self, _: usize) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn move_cursor_left(&self, _: usize) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn write_line(&self, s: &str) -> std::io::Result<()> {
+            self.write_str(&format!("{s}\n"))
+        }
+        fn write_str(&self, s: &str) -> std::io::Result<()> {
+            self.0.lock().unwrap().push_str(s);
+            Ok(())
+        }
+        fn clear_line(&self) -> std::io::Result<()> {
+            Ok(())
+        }
+        fn flush(&self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    impl Write for Screen {
+        fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+            self.write_str(&String::from_utf8_lossy(buf))?;
+            Ok(buf.len())
+        }
+        fn flush(&mut self) -> std::io::Result<()> {
+            Ok(())
+        }
+    }
+
+    #[test]
+    fn a_finished_bar_ends_its_line_before_the_summary() {
+        let mut screen = Screen::default();
+        let target = ProgressDrawTarget::term_like(Box::new(screen.clone()));
+        let bar = ProgressBar::with_draw_target(Some(1000), target);
+        let progress = Progress::with_bar(RunLength::Steps(40), Some(bar));
+        progress.finish_on(&mut screen);
+        write!(screen, "scene  dam_break").unwrap();
+        let text = screen.text();
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(
+            lines.last(),
+            Some(&"scene  dam_break"),
+            "the summary is glued to the bar: {text:?}"
+        );
+        let bar_line = lines[lines.len() - 2];
+        assert!(
+            bar_line.contains("100%") && bar_line.contains("0/40 steps"),
+            "the bar's final state is drawn: {text:?}"
+        );
+    }
+
+    #[test]
+    fn without_a_terminal_finishing_writes_nothing() {
+        let mut screen = Screen::default();
+        Progress::with_bar(RunLength::Steps(40), None).finish_on(&mut screen);
+        assert_eq!(screen.text(), "");
     }
 }

@@ -910,8 +910,9 @@ enum PfStatus pf_world_get_velocities(const struct PfWorld *world,
                                       size_t *needed);
 
 /**
- * Copies the fluid densities (kg/m³, 0 before the first step) into `out`, one float per
- * particle in ascending id order; otherwise like `pf_world_get_positions`.
+ * Copies the fluid densities (kg/m³; before a particle's first step, those evaluated when
+ * fluid was last added) into `out`, one float per particle in ascending id order; otherwise
+ * like `pf_world_get_positions`.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity_floats` writable floats; `needed` must be NULL or writable.

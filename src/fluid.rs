@@ -10,7 +10,7 @@ pub(crate) struct Fluid {
     pub positions: Vec<Vec3>,
     /// Velocities (m/s).
     pub velocities: Vec<Vec3>,
-    /// Densities after the last step (kg/m³; zero before the first step).
+    /// Densities after the last step, or where the fluid was last added (kg/m³).
     pub densities: Vec<f64>,
     /// The support each particle's constraints gave it in the last step, per unit mass
     /// (m/s²): its displacement from the inertial prediction over Δt², or zero where no

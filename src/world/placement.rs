@@ -9,7 +9,7 @@ use super::snapshot::Snapshot;
 use crate::Vec3;
 use crate::boundary::Aabb;
 use crate::boundary::mesh::TriangleMesh;
-use crate::boundary::winding::{is_closed_and_oriented, is_inside};
+use crate::boundary::winding::{is_closed_and_oriented, winding_number};
 use crate::neighbors::NeighborLists;
 use rayon::prelude::*;
 
@@ -45,8 +45,94 @@ impl Solids {
             || self
                 .closed
                 .iter()
-                .any(|(mesh, bounds)| bounds.contains(p, 0.0) && is_inside(mesh, p))
+                .any(|(mesh, bounds)| bounds.contains(p, 0.0) && inside(mesh, p))
     }
+}
+
+/// How far (m) a point may lie inside a closed mesh and still count as on its surface.
+const SURFACE_TOLERANCE: f64 = 1e-6;
+
+/// Whether `p` (m) lies inside the closed mesh, farther than [`SURFACE_TOLERANCE`] from its
+/// surface: fluid may touch a solid. The winding number is 1 inside and 0 outside, and on the
+/// surface itself, where it is undefined, one of the six points that tolerance away along the
+/// axes reads 0.
+fn inside(mesh: &TriangleMesh, p: &Vec3) -> bool {
+    let e = SURFACE_TOLERANCE;
+    // The winding number is −1 inside a mesh whose triangles face inwards.
+    winding_number(mesh, p).abs() > 0.5
+        && (0..6).all(|k| {
+            let mut q = *p;
+            q[k / 2] += if k % 2 == 0 { e } else { -e };
+            winding_number(mesh, &q).abs() > 0.5
+        })
+}
+
+/// The point of triangle `t` (its corners, m) nearest to `p` (m) (Ericson, *Real-Time
+/// Collision Detection*, §5.1.5).
+fn nearest_on_triangle(p: &Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(&ap), ac.dot(&ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return a;
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(&bp), ac.dot(&bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return b;
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return a + ab * (d1 / (d1 - d3));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(&cp), ac.dot(&cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return c;
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return a + ac * (d2 / (d2 - d6));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && d4 - d3 >= 0.0 && d5 - d6 >= 0.0 {
+        return b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6)));
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    a + ab * (vb * denominator) + ac * (vc * denominator)
+}
+
+/// Moves `p` (m), outside the closed `mesh` or on it, to at least `r` (m) from its surface,
+/// straight away from the nearest surface point (along the nearest triangle's outward normal
+/// where `p` lies on the surface).
+fn clear_of_mesh(p: &mut Vec3, mesh: &TriangleMesh, r: f64) {
+    let vertices = mesh.vertices();
+    let mut nearest: Option<(f64, Vec3, [Vec3; 3])> = None;
+    for t in mesh.triangles() {
+        let corners = t.map(|i| vertices[i as usize]);
+        let q = nearest_on_triangle(p, corners);
+        let d = (*p - q).norm_squared();
+        if nearest.is_none_or(|(best, _, _)| d < best) {
+            nearest = Some((d, q, corners));
+        }
+    }
+    let Some((d, q, [a, b, c])) = nearest else {
+        return;
+    };
+    if d >= r * r {
+        return;
+    }
+    let away = if d > SURFACE_TOLERANCE * SURFACE_TOLERANCE {
+        (*p - q).normalize()
+    } else {
+        let n = (b - a).cross(&(c - a)).normalize();
+        let probe = q + n * (2.0 * SURFACE_TOLERANCE);
+        if winding_number(mesh, &probe).abs() > 0.5 {
+            -n
+        } else {
+            n
+        }
+    };
+    *p = q + away * r;
 }
 
 /// Moves every particle of `positions` (m) that has a holding container in `holders` to at
@@ -88,10 +174,13 @@ impl World {
     }
 
     /// Settles the fluid particles whose ids are `first_id` or later, just added: moves those
-    /// nearer than r to a wall of the container that holds them out to r, then projects the
+    /// nearer than r to a wall of the container that holds them, or to a closed obstacle or
+    /// body, out to r (and keeps them there while it projects), then projects the
     /// density constraints of every particle near them on their positions alone until no
     /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] (or [`PLACEMENT_PASSES`]
-    /// have run). Velocities and the particles added before stay as they are.
+    /// have run). Velocities and the particles added before stay as they are; every
+    /// particle's density is then evaluated where it stands, as frames and reads report it
+    /// until the next step.
     ///
     /// # Panics
     /// When the memory for the neighbour search cannot be had (as the readings between steps).
@@ -107,19 +196,40 @@ impl World {
                 holder.filter(|_| id >= first_id).copied()
             })
             .collect();
-        clear_of_walls(&mut self.fluid.positions, &holders, r);
+        let closed = self.solids().closed;
+        let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
+        let clear = |positions: &mut [Vec3]| {
+            clear_of_walls(positions, &holders, r);
+            for (mesh, bounds) in &closed {
+                let reach = Aabb {
+                    min: bounds.min - Vec3::repeat(r),
+                    max: bounds.max + Vec3::repeat(r),
+                };
+                positions
+                    .par_iter_mut()
+                    .zip(&movable)
+                    .filter(|(p, free)| **free && reach.contains(p, 0.0))
+                    .for_each(|(p, _)| clear_of_mesh(p, mesh, r));
+            }
+        };
+        self.pool.install(|| clear(&mut self.fluid.positions));
         let settled = self
             .pool
-            .install(|| self.placement_projection(first_id, &holders));
+            .install(|| self.placement_projection(first_id, &clear));
         if let Some(settled) = settled {
             self.fluid.positions = settled;
         }
+        self.fluid.densities = self.densities_now();
     }
 
     /// The fluid's positions (m, in storage order) after the passes of
     /// [`World::settle_new_fluid`]'s projection, or `None` where nothing was compressed.
     /// Runs on the caller's pool.
-    fn placement_projection(&self, first_id: u64, holders: &[Option<Aabb>]) -> Option<Vec<Vec3>> {
+    fn placement_projection(
+        &self,
+        first_id: u64,
+        clear: &(dyn Fn(&mut [Vec3]) + Sync),
+    ) -> Option<Vec<Vec3>> {
         let h = self.params.support_radius();
         let step = PLACEMENT_STEP * self.params.particle_radius;
         let mut snapshot = self.snapshot_with(h, true)?;
@@ -182,7 +292,7 @@ impl World {
             for ((p, d), &i) in x.iter().zip(&moves).zip(&snapshot.fluid_order) {
                 positions[i as usize] = p + d;
             }
-            clear_of_walls(&mut positions, holders, self.params.particle_radius);
+            clear(&mut positions);
             snapshot
                 .grid
                 .sort(

@@ -57,7 +57,8 @@ impl World {
     }
 
     /// Fluid densities (kg/m³) after the last step, in ascending id order (see
-    /// [`World::ids`]; zero before a particle's first step).
+    /// [`World::ids`]); before a particle's first step, those evaluated when fluid was last
+    /// added.
     pub fn densities(&self) -> Vec<f64> {
         let mut out = vec![0.0; self.fluid_count()];
         self.gather_by_id(&self.fluid.densities, &mut out);
@@ -167,7 +168,7 @@ impl World {
         self.write_vectors_f32(&self.fluid.velocities, out)
     }
 
-    /// Writes fluid densities (kg/m³, zero before the first step) into
+    /// Writes fluid densities (kg/m³, as [`World::densities`] reports them) into
     /// `out[..fluid_count()]` in ascending id order; errs with the number of floats needed,
     /// leaving `out` untouched, when `out` is too short.
     pub fn write_densities_f32(&self, out: &mut [f32]) -> Result<(), usize> {

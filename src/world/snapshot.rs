@@ -199,7 +199,19 @@ impl World {
     /// # Panics
     /// When the memory for the neighbour search cannot be had.
     pub fn current_densities(&self) -> Vec<f64> {
-        let in_storage_order = self.pool.install(|| {
+        let in_storage_order = self.densities_now();
+        let mut out = vec![0.0; self.fluid_count()];
+        self.gather_by_id(&in_storage_order, &mut out);
+        out
+    }
+
+    /// The SPH density ρ_i (kg/m³) of every fluid particle at its current position, in
+    /// storage order.
+    ///
+    /// # Panics
+    /// When the memory for the neighbour search cannot be had.
+    pub(crate) fn densities_now(&self) -> Vec<f64> {
+        self.pool.install(|| {
             let Some(snapshot) = self.snapshot() else {
                 return Vec::new();
             };
@@ -212,9 +224,6 @@ impl World {
                 out[k as usize] = value;
             }
             out
-        });
-        let mut out = vec![0.0; self.fluid_count()];
-        self.gather_by_id(&in_storage_order, &mut out);
-        out
+        })
     }
 }

@@ -177,6 +177,7 @@ SIGNATURES: dict[str, tuple[list[Any], Any]] = {
     "pf_world_relax": ([_world, c_double, c_double], _status),
     # reading
     "pf_world_fluid_count": ([_world, _sizes], _status),
+    "pf_world_last_added_count": ([_world, _sizes], _status),
     "pf_world_boundary_count": ([_world, _sizes], _status),
     "pf_world_time": ([_world, _doubles], _status),
     "pf_world_get_params": ([_world, _params], _status),

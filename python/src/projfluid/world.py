@@ -108,10 +108,13 @@ class World(BodiesMixin, FlowMixin):
         start: Vector3,
         count: tuple[int, int, int],
         velocity: Vector3 | None = None,
-    ) -> None:
+    ) -> int:
         """Adds a block of ``count`` = (nx, ny, nz) fluid particles on a lattice of spacing
         2r whose first particle is at ``start`` (m), all moving at ``velocity`` (m/s; None:
-        at rest). Particles are numbered x fastest, then y, then z."""
+        at rest), and returns how many it made: particles whose centres lie inside a solid
+        (outside every container, inside a closed obstacle or body) are not created. The
+        block starts calm however close to a wall it is put. Particles are numbered x
+        fastest, then y, then z."""
         try:
             nx, ny, nz = (int(n) for n in count)
         except (TypeError, ValueError):
@@ -125,15 +128,16 @@ class World(BodiesMixin, FlowMixin):
             (c_size_t * 3)(nx, ny, nz),
             c_velocity,
         )
+        return self._size(lib.pf_world_last_added_count)
 
-    def add_fluid_particles(self, positions: Any, velocities: Any = None) -> None:
+    def add_fluid_particles(self, positions: Any, velocities: Any = None) -> int:
         """Adds fluid particles at ``positions``, an (n, 3) array (m), at rest or moving at
-        ``velocities``, an (n, 3) array (m/s). Values are rounded to float32, as C sees
-        them."""
+        ``velocities``, an (n, 3) array (m/s), and returns how many it made (as
+        :meth:`add_fluid_box`). Values are rounded to float32, as C sees them."""
         xyz = _arrays.rows(positions, 3, np.float32, "positions")
         if velocities is None:
             self._call(lib.pf_world_add_fluid_particles, _arrays.pointer(xyz, c_float), len(xyz))
-            return
+            return self._size(lib.pf_world_last_added_count)
         v = _arrays.rows(velocities, 3, np.float32, "velocities")
         if v.shape != xyz.shape:
             raise ValueError(f"velocities has shape {v.shape}, positions {xyz.shape}")
@@ -143,6 +147,7 @@ class World(BodiesMixin, FlowMixin):
             _arrays.pointer(v, c_float),
             len(xyz),
         )
+        return self._size(lib.pf_world_last_added_count)
 
     def add_boundary_particles(self, positions: Any) -> None:
         """Adds static boundary particles at ``positions``, an (n, 3) array (m), for
@@ -292,7 +297,8 @@ class World(BodiesMixin, FlowMixin):
 
     def densities(self, out: np.ndarray | None = None) -> np.ndarray:
         """The fluid particles' densities (kg/m³) as an (n,) float32 array, as the last step
-        left them; ``out`` as in :meth:`positions`."""
+        left them (before a particle's first step, as evaluated when fluid was last added);
+        ``out`` as in :meth:`positions`."""
         return self._read(lib.pf_world_get_densities, out, 1, np.float32, c_float, "out")
 
     def ids(self, out: np.ndarray | None = None) -> np.ndarray:

@@ -47,3 +47,8 @@ pub use world::{BodyId, EmitterId, GridParts, SinkId, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).
 pub type Vec3 = nalgebra::Vector3<f64>;
+
+/// The README's Rust quick start, compiled and run as written by the doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeQuickStart;

@@ -6,8 +6,8 @@
 //! Outside CI a missing valgrind, python3, make, pkg-config, readelf or cmake skips its
 //! check with a note; under CI it fails the test (`support/tools.rs`).
 //!
-//! Under `cargo test` the libraries sit next to this test's executable in
-//! `target/<profile>/deps/`.
+//! Under `cargo test --release` the libraries sit next to this test's executable in
+//! `target/release/deps/` (`target/<profile>/deps/` for another profile).
 
 use projfluid::boundary::Aabb;
 use projfluid::scene::Scene;
@@ -344,7 +344,30 @@ fn c_worlds_from_scenes_reject_misuse_and_match_the_rust_api() {
 #[test]
 fn c_examples_build_and_run() {
     let out = run(&build("c_examples/minimal.c", Link::Static), &[]);
-    assert!(out.contains("first particle at"), "{out}");
+    // The README's quick start, as written, starts calm: every particle made, the water lower
+    // than it started (no jolt lifts it), no step at the iteration limit.
+    let line = out.lines().next().unwrap_or_default();
+    assert!(line.starts_with("216 particles, mean height "), "{out}");
+    let height: f64 = line["216 particles, mean height ".len()..]
+        .split(' ')
+        .next()
+        .and_then(|h| h.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(height < 0.175 && height > 0.05, "{out}");
+    assert!(!line.contains("limit"), "{out}");
+    let outer: usize = line
+        .split("last step: ")
+        .nth(1)
+        .and_then(|rest| rest.split(' ').next())
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("{out}"));
+    assert!(outer < 50, "{out}");
+    let readme = std::fs::read_to_string(root().join("README.md")).unwrap();
+    let example = std::fs::read_to_string(root().join("c_examples/minimal.c")).unwrap();
+    assert!(
+        readme.contains(&format!("```c\n{example}```")),
+        "the README's C quick start is not c_examples/minimal.c"
+    );
 
     // The example simulates 0.5 s by default; a shorter run keeps the test fast.
     let out = run(&build("c_examples/dam_break.c", Link::Shared), &["0.1"]);
@@ -480,8 +503,8 @@ fn make_install_layout_works_with_pkg_config_and_cmake() {
     }
     let prefix = out_dir().join("prefix");
     let _ = std::fs::remove_dir_all(&prefix);
-    // `install-files` is `make install` without its `cargo build --release` step, fed with
-    // the libraries of this build.
+    // `install-files` is `make install` without its build step (`make build`), fed with the
+    // libraries of this build.
     let output = Command::new("make")
         .current_dir(root())
         .arg("install-files")

@@ -18,8 +18,12 @@ STRIP ?= strip
 
 all: build
 
+# The workspace's libraries (projfluid's and the command line's): built for the whole
+# workspace, the dependencies get the features `cargo run --release` and `cargo test --release`
+# give them, so the three commands share one build; building projfluid alone would compile
+# serde, faer and projfluid again with other features.
 build:
-	$(CARGO) build --release --lib --package projfluid
+	$(CARGO) build --release --workspace --lib
 
 install: build install-files
 

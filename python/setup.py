@@ -1,23 +1,29 @@
 """Builds the projfluid C library with cargo and puts it inside the package, so that
 `pip install ./python` from a projfluid checkout gives a self-contained wheel.
 
+The build is the one `cargo run --release`, `cargo test --release` and `make install` make
+(the workspace's libraries, release profile), so after any of them cargo finds the library up
+to date and the package reuses it. pip shows a build's output only with `-v`, so cargo's
+progress goes to the terminal when there is one, and to stderr otherwise.
+
 Environment:
   CARGO                    the cargo to run (default: cargo on PATH)
-  CARGO_TARGET_DIR         cargo's target directory (default: target/ of the checkout);
-                           set it to the one `cargo test` uses to reuse its build
+  CARGO_TARGET_DIR         cargo's target directory (default: target/ of the checkout)
   PROJFLUID_CARGO_PROFILE  the cargo profile (default: release)
   PROJFLUID_LIBRARY        an already built libprojfluid.so to bundle instead of running
-                           cargo (CI bundles the one `cargo test` built and tested)
+                           cargo
 """
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import shutil
 import subprocess
 import sys
 from pathlib import Path
+from typing import TextIO
 
 from setuptools import setup
 from setuptools.command.bdist_wheel import bdist_wheel
@@ -45,6 +51,15 @@ def cargo_version() -> str:
     return match.group(1)
 
 
+def terminal() -> TextIO | None:
+    """The terminal pip runs in, if any: pip captures a build's stdout and stderr and shows
+    them only with -v, so the build reports its progress there."""
+    try:
+        return open("/dev/tty", "w", encoding="utf-8")  # noqa: SIM115 (closed by the caller)
+    except OSError:
+        return None
+
+
 def build_library() -> Path:
     """Runs cargo to build the C library and returns the built file."""
     if not (CHECKOUT / "include" / "projfluid.h").exists():
@@ -54,16 +69,48 @@ def build_library() -> Path:
         )
     profile = os.environ.get("PROJFLUID_CARGO_PROFILE", "release")
     cargo = os.environ.get("CARGO", "cargo")
-    command = [cargo, "build", "--lib", "--package", "projfluid", "--profile", profile]
-    print("building the C library:", " ".join(command), flush=True)
-    subprocess.run(command, cwd=CHECKOUT, check=True)
-    target = Path(os.environ.get("CARGO_TARGET_DIR") or CHECKOUT / "target")
-    if not target.is_absolute():
-        target = CHECKOUT / target
-    directory = {"dev": "debug", "test": "debug", "bench": "release"}.get(profile, profile)
-    built = target / directory / library_file_name()
-    if not built.exists():
-        raise RuntimeError(f"cargo did not produce {built}")
+    # The workspace's libraries, as `make install` builds them: the features `cargo run` and
+    # `cargo test` give the dependencies, and so the same build, which cargo finds up to date
+    # after any of them. Its messages (the progress bar, errors) go to the terminal; its
+    # standard output says what it built.
+    command = [cargo, "build", "--workspace", "--lib", "--profile", profile]
+    tty = terminal()
+    out = tty or sys.stderr
+    try:
+        print(
+            ("\n" if tty else "") + f"projfluid: building the C library: {' '.join(command)}\n"
+            "projfluid: (minutes the first time; a second after `cargo run --release`, "
+            "`cargo test --release` or `make install`, which build the same)",
+            file=out,
+            flush=True,
+        )
+        done = subprocess.run(
+            [*command, "--message-format=json-render-diagnostics"],
+            cwd=CHECKOUT,
+            check=True,
+            stdout=subprocess.PIPE,
+            stderr=out,
+            text=True,
+        )
+        built: Path | None = None
+        fresh = False
+        for line in done.stdout.splitlines():
+            message = json.loads(line)
+            if message.get("reason") != "compiler-artifact":
+                continue
+            for file in message["filenames"]:
+                if Path(file).name == library_file_name():
+                    built, fresh = Path(file), message["fresh"]
+        if built is None or not built.exists():
+            raise RuntimeError(f"`{' '.join(command)}` built no {library_file_name()}")
+        print(
+            f"projfluid: {'already built, up to date' if fresh else 'built'}: {built}",
+            file=out,
+            flush=True,
+        )
+    finally:
+        if tty:
+            tty.close()
     return built
 
 

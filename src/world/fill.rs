@@ -42,7 +42,8 @@ fn lattice(
 impl World {
     /// Adds fluid particles at `positions` (m) with `velocities` (m/s; zero when `None`)
     /// where they do not lie inside a solid (outside every container box, or inside a closed
-    /// obstacle or body), and settles them as [`World::add_fluid_block`] does. Returns how
+    /// obstacle or body), moving those nearer than r to a wall, a closed obstacle or a body out
+    /// to r (they are not projected as [`World::add_fluid_block`]'s are). Returns how
     /// many it added; they get the next ids in the order given (see [`World::ids`]). Rejects
     /// non-finite values, length mismatches, too many particles and
     /// ([`Error::OutOfMemory`]) a shortage of memory without changing the world.
@@ -84,7 +85,7 @@ impl World {
                 .fluid
                 .extend(at, std::iter::repeat_n(Vec3::zeros(), added)),
         }
-        self.settle_new_fluid(first);
+        self.settle_new_fluid(first, false);
         self.last_added = added;
         Ok(added)
     }
@@ -138,7 +139,7 @@ impl World {
         let kept = lattice(count, at).filter(|p| !solids.contain(p));
         self.fluid
             .extend(kept, std::iter::repeat_n(velocity, added));
-        self.settle_new_fluid(first);
+        self.settle_new_fluid(first, true);
         self.last_added = added;
         Ok(added)
     }

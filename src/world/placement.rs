@@ -180,11 +180,12 @@ impl World {
     /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] (or [`PLACEMENT_PASSES`]
     /// have run). Velocities and the particles added before stay as they are; every
     /// particle's density is then evaluated where it stands, as frames and reads report it
-    /// until the next step.
+    /// until the next step. Without `project` only the moves out of the walls are made
+    /// (particles given one by one may crowd arbitrarily, which no projection should chase).
     ///
     /// # Panics
     /// When the memory for the neighbour search cannot be had (as the readings between steps).
-    pub(super) fn settle_new_fluid(&mut self, first_id: u64) {
+    pub(super) fn settle_new_fluid(&mut self, first_id: u64, project: bool) {
         let r = self.params.particle_radius;
         let holders: Vec<Option<Aabb>> = self
             .fluid
@@ -213,6 +214,9 @@ impl World {
             }
         };
         self.pool.install(|| clear(&mut self.fluid.positions));
+        if !project {
+            return;
+        }
         let settled = self
             .pool
             .install(|| self.placement_projection(first_id, &clear));

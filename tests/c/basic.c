@@ -114,7 +114,7 @@ int main(int argc, char **argv) {
     OK(pf_world_get_velocities(world, vel, 3 * n, NULL));
     CHECK(vel[3 * (n - 2)] == -1.0f && vel[3 * (n - 1) + 1] == 0.5f && vel[0] == 0.0f);
     OK(pf_world_get_densities(world, rho, n, &needed));
-    CHECK(needed == n && rho[0] == 0.0f);
+    CHECK(needed == n && rho[0] > 0.0f); /* evaluated where the fluid was placed */
 
     /* Particle ids: 0..n-1 in the order the particles were added, the order of every read. */
     uint64_t *ids = malloc(n * sizeof *ids);

@@ -84,7 +84,13 @@ static int child(void) {
     limit_address_space(-1.0);
     const size_t more[3] = {50, 50, 40};
     const float aside[3] = {1.0f, 0.05f, 0.05f};
+    /* Fluid outside every container would not be created: a second box holds this block. */
+    const float lo2[3] = {0.9f, 0.0f, 0.0f}, hi2[3] = {3.6f, 2.6f, 2.1f};
+    OK(pf_world_add_container_box(w, lo2, hi2, 1));
     OK(pf_world_add_fluid_box(w, aside, more, NULL));
+    size_t made = 0;
+    OK(pf_world_last_added_count(w, &made));
+    CHECK(made == 50 * 50 * 40);
     limit_address_space(8e6);
     OUT_OF_MEMORY(w, pf_world_step(w, 0.0));
     OUT_OF_MEMORY(w, pf_world_advance(w, 0.01));

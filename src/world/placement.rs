@@ -177,8 +177,8 @@ impl World {
     /// nearer than r to a wall of the container that holds them, or to a closed obstacle or
     /// body, out to r (and keeps them there while it projects), then projects the
     /// density constraints of every particle near them on their positions alone until no
-    /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] (or [`PLACEMENT_PASSES`]
-    /// have run). Velocities and the particles added before stay as they are; every
+    /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a
+    /// lattice block reads at the world's mass factor (or [`PLACEMENT_PASSES`] have run). Velocities and the particles added before stay as they are; every
     /// particle's density is then evaluated where it stands, as frames and reads report it
     /// until the next step. Without `project` only the moves out of the walls are made
     /// (particles given one by one may crowd arbitrarily, which no projection should chase).
@@ -237,6 +237,8 @@ impl World {
         let h = self.params.support_radius();
         let step = PLACEMENT_STEP * self.params.particle_radius;
         let mut snapshot = self.snapshot_with(h, true)?;
+        // What the lattice itself reads is the mass factor's choice, not placement's to undo.
+        let tolerance = PLACEMENT_TOLERANCE + self.lattice_compression();
         let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
         let mut positions = self.fluid.positions.clone();
         let rest = self.constraint.rest_density;
@@ -259,7 +261,7 @@ impl World {
             let lists = (&fluid_lists, &boundary_lists);
             let lambdas = self.placement_multipliers(&snapshot, lists, &free);
             let worst = lambdas.iter().map(|l| l.1).fold(0.0, f64::max);
-            if worst <= PLACEMENT_TOLERANCE {
+            if worst <= tolerance {
                 break;
             }
             moved = true;
@@ -309,6 +311,19 @@ impl World {
             snapshot.fluid = order.iter().map(|&i| positions[i as usize]).collect();
         }
         moved.then_some(positions)
+    }
+
+    /// The compression (dimensionless, ≥ 0) of the bulk of a lattice block of spacing 2r:
+    /// 0 at the default mass factor, which makes the bulk read ρ0 (docs/method.md §2.2).
+    fn lattice_compression(&self) -> f64 {
+        let (k, d) = (&self.constraint.kernel, self.params.spacing());
+        let mut sum = 0.0;
+        for (i, j, l) in (-2i32..=2)
+            .flat_map(|i| (-2i32..=2).flat_map(move |j| (-2i32..=2).map(move |l| (i, j, l))))
+        {
+            sum += k.w(Vec3::new(i as f64, j as f64, l as f64).norm() * d);
+        }
+        (self.constraint.mass * sum / self.constraint.rest_density - 1.0).max(0.0)
     }
 
     /// For every fluid particle of `snapshot`, the multiplier λ_i of its density constraint's

@@ -5,6 +5,9 @@
 //! installed (`.ci/run` makes such a virtualenv). Outside CI a missing interpreter or
 //! module skips the check with a note; under CI it fails the test.
 
+#[path = "support/library.rs"]
+mod library;
+
 use std::path::PathBuf;
 use std::process::Command;
 
@@ -36,13 +39,7 @@ fn the_python_packages_tests_pass_against_this_library() {
     let Some(python) = python() else {
         return;
     };
-    let exe = std::env::current_exe().expect("the test knows its own path");
-    let library = exe.with_file_name("libprojfluid.so");
-    assert!(
-        library.exists(),
-        "{} is missing; the crate's cdylib should be built by cargo test",
-        library.display()
-    );
+    let library = library::shared_library();
     let cache = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("pytest-cache");
     let output = Command::new(&python)
         .current_dir(root().join("python"))

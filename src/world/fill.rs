@@ -85,7 +85,7 @@ impl World {
                 .fluid
                 .extend(at, std::iter::repeat_n(Vec3::zeros(), added)),
         }
-        self.settle_new_fluid(first, false);
+        self.settle_new_fluid(first, solids, false);
         self.last_added = added;
         Ok(added)
     }
@@ -139,7 +139,7 @@ impl World {
         let kept = lattice(count, at).filter(|p| !solids.contain(p));
         self.fluid
             .extend(kept, std::iter::repeat_n(velocity, added));
-        self.settle_new_fluid(first, true);
+        self.settle_new_fluid(first, solids, true);
         self.last_added = added;
         Ok(added)
     }

@@ -173,19 +173,21 @@ impl World {
         }
     }
 
-    /// Settles the fluid particles whose ids are `first_id` or later, just added: moves those
-    /// nearer than r to a wall of the container that holds them, or to a closed obstacle or
-    /// body, out to r (and keeps them there while it projects), then projects the
-    /// density constraints of every particle near them on their positions alone until no
-    /// constraint is compressed by more than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a
-    /// lattice block reads at the world's mass factor (or [`PLACEMENT_PASSES`] have run). Velocities and the particles added before stay as they are; every
-    /// particle's density is then evaluated where it stands, as frames and reads report it
-    /// until the next step. Without `project` only the moves out of the walls are made
-    /// (particles given one by one may crowd arbitrarily, which no projection should chase).
+    /// Settles the fluid particles whose ids are `first_id` or later, just added among
+    /// `solids` (the world's, as [`World::solids`] gave them): moves those nearer than r to a
+    /// wall of the container that holds them, or to a closed obstacle or body, out to r (and
+    /// keeps them there while it projects), then projects the density constraints of every
+    /// particle near them on their positions alone until no constraint is compressed by more
+    /// than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a lattice block reads at the
+    /// world's mass factor (or [`PLACEMENT_PASSES`] have run). Velocities and the particles
+    /// added before stay as they are; every particle's density is then evaluated where it
+    /// stands, as frames and reads report it until the next step. Without `project` only the
+    /// moves out of the walls are made (particles given one by one may crowd arbitrarily,
+    /// which no projection should chase).
     ///
     /// # Panics
     /// When the memory for the neighbour search cannot be had (as the readings between steps).
-    pub(super) fn settle_new_fluid(&mut self, first_id: u64, project: bool) {
+    pub(super) fn settle_new_fluid(&mut self, first_id: u64, solids: Solids, project: bool) {
         let r = self.params.particle_radius;
         let holders: Vec<Option<Aabb>> = self
             .fluid
@@ -197,7 +199,7 @@ impl World {
                 holder.filter(|_| id >= first_id).copied()
             })
             .collect();
-        let closed = self.solids().closed;
+        let closed = solids.closed;
         let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
         let clear = |positions: &mut [Vec3]| {
             clear_of_walls(positions, &holders, r);
@@ -219,7 +221,7 @@ impl World {
         }
         let settled = self
             .pool
-            .install(|| self.placement_projection(first_id, &clear));
+            .install(|| self.placement_projection(&movable, &clear));
         if let Some(settled) = settled {
             self.fluid.positions = settled;
         }
@@ -227,11 +229,12 @@ impl World {
     }
 
     /// The fluid's positions (m, in storage order) after the passes of
-    /// [`World::settle_new_fluid`]'s projection, or `None` where nothing was compressed.
+    /// [`World::settle_new_fluid`]'s projection of the particles marked in `movable` (in
+    /// storage order), or `None` where nothing was compressed.
     /// Runs on the caller's pool.
     fn placement_projection(
         &self,
-        first_id: u64,
+        movable: &[bool],
         clear: &(dyn Fn(&mut [Vec3]) + Sync),
     ) -> Option<Vec<Vec3>> {
         let h = self.params.support_radius();
@@ -239,7 +242,6 @@ impl World {
         let mut snapshot = self.snapshot_with(h, true)?;
         // What the lattice itself reads is the mass factor's choice, not placement's to undo.
         let tolerance = PLACEMENT_TOLERANCE + self.lattice_compression();
-        let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
         let mut positions = self.fluid.positions.clone();
         let rest = self.constraint.rest_density;
         let (k, m) = (&self.constraint.kernel, self.constraint.mass);

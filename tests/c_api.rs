@@ -589,6 +589,9 @@ fn make_install_layout_works_with_pkg_config_and_cmake() {
         .output()
         .expect("cmake runs");
     assert!(compile.status.success(), "{}", describe(&compile));
-    let out = run(&build_dir.join("minimal"), &[]);
-    assert!(out.contains("first particle at"), "{out}");
+    let from_cmake = run(&build_dir.join("minimal"), &[]);
+    assert_eq!(
+        from_cmake, out,
+        "the CMake build of minimal.c prints what the pkg-config build printed"
+    );
 }

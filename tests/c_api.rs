@@ -595,3 +595,26 @@ fn make_install_layout_works_with_pkg_config_and_cmake() {
         "the CMake build of minimal.c prints what the pkg-config build printed"
     );
 }
+
+/// The placement sweep of tests/placement.rs from C: blocks put 0 to 3 radii from container
+/// walls of particles and of fields, a closed obstacle mesh and static and kinematic box
+/// bodies start calm on one and two threads alike, and fluid placed in a solid is not made.
+#[test]
+fn c_placement_sweep_starts_calm_against_every_solid_on_one_and_two_threads() {
+    for link in [Link::Static, Link::Shared] {
+        let out = run(&build("tests/c/placement.c", link), &[]);
+        assert_eq!(out.lines().last(), Some("placement: ok"), "{link:?}: {out}");
+        for solid in [
+            "wall particles:",
+            "wall fields:",
+            "obstacle mesh:",
+            "static body:",
+            "kinematic body:",
+        ] {
+            assert!(
+                out.lines().any(|l| l.starts_with(solid)),
+                "{link:?}: no line for {solid}\n{out}"
+            );
+        }
+    }
+}

@@ -200,7 +200,7 @@ impl Emitter {
     }
 
     /// The opening's lattice area (m²): lattice points per layer × d². The emitter inserts
-    /// speed × area / d³ particles per second on average (fewer where fluid is in the way).
+    /// speed × area / d³ particles per second on average (fewer where fluid or a solid is in the way).
     pub fn area(&self) -> f64 {
         self.points.len() as f64 * self.spacing * self.spacing
     }
@@ -298,6 +298,23 @@ impl Emitter {
                         }
                     }
                 }
+            }
+        }
+    }
+
+    /// Marks in `blocked` (as [`Emitter::mark_blocked`] filled it) also the points of the
+    /// layers at `offsets` that `inside_solid` says lie inside a solid.
+    pub(crate) fn mark_solid(
+        &self,
+        offsets: &[f64],
+        inside_solid: impl Fn(&Vec3) -> bool,
+        blocked: &mut [bool],
+    ) {
+        let (centre, n, len) = (self.state.spec.position, self.axes[0], self.points.len());
+        for (l, &offset) in offsets.iter().enumerate() {
+            for (k, p) in self.points.iter().enumerate() {
+                let at = l * len + k;
+                blocked[at] = blocked[at] || inside_solid(&(centre + p + n * offset));
             }
         }
     }

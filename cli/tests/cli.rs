@@ -1188,3 +1188,28 @@ fn bad_probes_exit_2() {
     );
     std::fs::remove_dir_all(&dir).unwrap();
 }
+
+/// A fluid block overlapping a static body: the run's first line says how many particles the
+/// scene's blocks held inside the solid and were not created.
+#[test]
+fn a_run_says_how_many_block_particles_lay_inside_solids() {
+    let dir = temp_dir("inside-solids");
+    // The block's middle column (x = 0.2 m, 9 particles) lies inside the box.
+    let body = r#""bodies": [{"kind": "static", "box": {"half_extents": [0.05, 0.2, 0.2]}, "position": [0.2, 0.2, 0.2]}],
+  "duration""#;
+    let out = run_scene_text(&dir, "inside.json", &scene_with("\"duration\"", body));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(
+            "cli_test: 18 particles (9 of the fluid blocks' particles lay inside solids and \
+             were not created), "
+        ),
+        "{stderr}"
+    );
+    // Without the body every particle is created, and the line says nothing of solids.
+    let out = run_scene_text(&dir, "free.json", &scene_with("", ""));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("cli_test: 27 particles, "), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -1,6 +1,7 @@
 //! Emitters in a world (docs/method.md §12.2): adding them, and inserting their due layers
 //! at the start of a step.
 
+use super::placement::Settling;
 use super::{MAX_PARTICLES, World};
 use crate::Error;
 use crate::emitter::{Emitter, EmitterSpec, EmitterState};
@@ -72,30 +73,43 @@ impl World {
     }
 
     /// Inserts every emitter's due layers at the start of a step (emitters in order, each
-    /// layer's free lattice points in lattice order), so that they get the next ids. The
-    /// caller checked the particle limit ([`World::check_emission`]) and reserved the
+    /// layer's free lattice points in lattice order), so that they get the next ids. Points
+    /// inside a solid (outside every container, inside a closed obstacle or body) are not
+    /// inserted, and the new particles are settled as placed fluid is (docs/method.md §2.7).
+    /// The caller checked the particle limit ([`World::check_emission`]) and reserved the
     /// fluid's storage; errors when memory for the layers' scratch cannot be had, with the
     /// emitters part-way (the caller puts them back).
     pub(super) fn emit(&mut self) -> Result<(), TryReserveError> {
         if self.emitters.is_empty() {
             return Ok(());
         }
+        let first = self.fluid.next_id;
+        let mut solids = None;
         let (mut offsets, mut blocked, mut points) = (Vec::new(), Vec::new(), Vec::new());
-        for emitter in &mut self.emitters {
-            emitter.take_due(self.time, &mut offsets);
+        for e in 0..self.emitters.len() {
+            self.emitters[e].take_due(self.time, &mut offsets);
             if offsets.is_empty() {
                 continue;
             }
+            let solids = match &mut solids {
+                Some(solids) => solids,
+                None => solids.insert(self.solids()),
+            };
+            let emitter = &mut self.emitters[e];
             let lattice = offsets.len() * emitter.layer_len();
             reserve_total(&mut blocked, lattice)?;
             reserve_total(&mut points, lattice)?;
             // Against the fluid as it is, including the layers other emitters just inserted.
             emitter.mark_blocked(&offsets, &self.fluid.positions, &mut blocked);
+            emitter.mark_solid(&offsets, |p| solids.contain(p), &mut blocked);
             let velocity = emitter.velocity();
             points.clear();
             points.extend(emitter.free_points(&offsets, &blocked));
             self.fluid
                 .push(&points, std::iter::repeat_n(velocity, points.len()));
+        }
+        if let Some(solids) = solids.filter(|_| self.fluid.next_id > first) {
+            self.settle_new_fluid(first, solids, Settling::Emitted);
         }
         Ok(())
     }

@@ -2,6 +2,7 @@
 //! triangle-mesh obstacles. Every method checks its input first and changes nothing when it
 //! rejects it.
 
+use super::placement::Settling;
 use super::{MAX_PARTICLES, World, box_wall_sample_count, check_finite};
 use crate::boundary::mesh::{TriangleMesh, sample_count_bound, sample_poisson_disk};
 use crate::boundary::winding::is_closed_and_oriented;
@@ -85,7 +86,7 @@ impl World {
                 .fluid
                 .extend(at, std::iter::repeat_n(Vec3::zeros(), added)),
         }
-        self.settle_new_fluid(first, solids, false);
+        self.settle_new_fluid(first, solids, Settling::Clear);
         self.last_added = added;
         Ok(added)
     }
@@ -139,7 +140,7 @@ impl World {
         let kept = lattice(count, at).filter(|p| !solids.contain(p));
         self.fluid
             .extend(kept, std::iter::repeat_n(velocity, added));
-        self.settle_new_fluid(first, solids, true);
+        self.settle_new_fluid(first, solids, Settling::Block);
         self.last_added = added;
         Ok(added)
     }

@@ -29,6 +29,25 @@ const PLACEMENT_RELAXATION: f64 = 0.5;
 /// Longest move of a particle in one pass, in particle radii r.
 const PLACEMENT_STEP: f64 = 0.25;
 
+/// Most passes of the projection of an emitter's new layers: a layer is one particle deep,
+/// and what a wall beside it compresses is gone in a few passes.
+const EMISSION_PASSES: usize = 40;
+
+/// How [`World::settle_new_fluid`] settles new fluid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Settling {
+    /// Moves the new particles out of the solids only (particles given one by one may crowd
+    /// arbitrarily, which no projection should chase).
+    Clear,
+    /// Also projects every compression near the new particles away on their positions, over
+    /// the whole world, and evaluates the densities frames report before the first step.
+    Block,
+    /// Also projects the new particles' own compressions away, within reach of them, in at
+    /// most [`EMISSION_PASSES`] passes: an emitter's layers, inserted at the start of a step
+    /// into fluid that is moving.
+    Emitted,
+}
+
 /// The solids a new fluid particle must not start inside: the container boxes (their
 /// outside) and the closed meshes of obstacles and bodies where they stand now.
 pub(super) struct Solids {
@@ -176,18 +195,15 @@ impl World {
     /// Settles the fluid particles whose ids are `first_id` or later, just added among
     /// `solids` (the world's, as [`World::solids`] gave them): moves those nearer than r to a
     /// wall of the container that holds them, or to a closed obstacle or body, out to r (and
-    /// keeps them there while it projects), then projects the density constraints of every
-    /// particle near them on their positions alone until no constraint is compressed by more
+    /// keeps them there while it projects), then, as `settling` says, projects the density
+    /// constraints on the new particles' positions alone until none is compressed by more
     /// than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a lattice block reads at the
-    /// world's mass factor (or [`PLACEMENT_PASSES`] have run). Velocities and the particles
-    /// added before stay as they are; every particle's density is then evaluated where it
-    /// stands, as frames and reads report it until the next step. Without `project` only the
-    /// moves out of the walls are made (particles given one by one may crowd arbitrarily,
-    /// which no projection should chase).
+    /// world's mass factor (or the passes run out). Velocities and the particles added before
+    /// stay as they are.
     ///
     /// # Panics
     /// When the memory for the neighbour search cannot be had (as the readings between steps).
-    pub(super) fn settle_new_fluid(&mut self, first_id: u64, solids: Solids, project: bool) {
+    pub(super) fn settle_new_fluid(&mut self, first_id: u64, solids: Solids, settling: Settling) {
         let r = self.params.particle_radius;
         let holders: Vec<Option<Aabb>> = self
             .fluid
@@ -216,16 +232,18 @@ impl World {
             }
         };
         self.pool.install(|| clear(&mut self.fluid.positions));
-        if !project {
+        if settling == Settling::Clear {
             return;
         }
         let settled = self
             .pool
-            .install(|| self.placement_projection(&movable, &clear));
+            .install(|| self.placement_projection(&movable, &clear, settling));
         if let Some(settled) = settled {
             self.fluid.positions = settled;
         }
-        self.fluid.densities = self.densities_now();
+        if settling == Settling::Block {
+            self.fluid.densities = self.densities_now();
+        }
     }
 
     /// The fluid's positions (m, in storage order) after the passes of
@@ -236,10 +254,28 @@ impl World {
         &self,
         movable: &[bool],
         clear: &(dyn Fn(&mut [Vec3]) + Sync),
+        settling: Settling,
     ) -> Option<Vec<Vec3>> {
         let h = self.params.support_radius();
         let step = PLACEMENT_STEP * self.params.particle_radius;
-        let mut snapshot = self.snapshot_with(h, true)?;
+        let (passes, region) = match settling {
+            Settling::Emitted => {
+                // The new particles, the fluid they can reach in the passes there are, and
+                // that fluid's neighbours.
+                let new = (0..movable.len())
+                    .filter(|&i| movable[i])
+                    .map(|i| self.fluid.positions[i]);
+                let reach = Vec3::repeat(2.0 * h + EMISSION_PASSES as f64 * step);
+                let around = Aabb::enclosing(new)?;
+                let region = Aabb {
+                    min: around.min - reach,
+                    max: around.max + reach,
+                };
+                (EMISSION_PASSES, Some(region))
+            }
+            _ => (PLACEMENT_PASSES, None),
+        };
+        let mut snapshot = self.snapshot_with(h, true, region.as_ref())?;
         // What the lattice itself reads is the mass factor's choice, not placement's to undo.
         let tolerance = PLACEMENT_TOLERANCE + self.lattice_compression();
         let mut positions = self.fluid.positions.clone();
@@ -247,8 +283,13 @@ impl World {
         let (k, m) = (&self.constraint.kernel, self.constraint.mass);
         let (mut fluid_lists, mut boundary_lists) =
             (NeighborLists::default(), NeighborLists::default());
+        // The storage indices of the fluid the snapshot holds, and their positions.
+        let mut taken = snapshot.fluid_order.clone();
+        taken.sort_unstable();
+        let mut at: Vec<Vec3> = Vec::with_capacity(taken.len());
+        let mut order = Vec::new();
         let mut moved = false;
-        for _ in 0..PLACEMENT_PASSES {
+        for _ in 0..passes {
             let x = &snapshot.fluid;
             let free: Vec<bool> = snapshot
                 .fluid_order
@@ -261,7 +302,10 @@ impl World {
                 .expect("memory for the placement's neighbour search");
             snapshot.boundary_near(x, h, &mut boundary_lists);
             let lists = (&fluid_lists, &boundary_lists);
-            let lambdas = self.placement_multipliers(&snapshot, lists, &free);
+            // Fluid moving through a step reads compressions of its own, which emitted
+            // particles are not to chase: they answer only for what they add.
+            let added_only = settling == Settling::Emitted;
+            let lambdas = self.placement_multipliers(&snapshot, lists, &free, added_only);
             let worst = lambdas.iter().map(|l| l.1).fold(0.0, f64::max);
             if worst <= tolerance {
                 break;
@@ -301,16 +345,14 @@ impl World {
                 positions[i as usize] = p + d;
             }
             clear(&mut positions);
+            at.clear();
+            at.extend(taken.iter().map(|&i| positions[i as usize]));
             snapshot
                 .grid
-                .sort(
-                    &positions,
-                    &mut snapshot.fluid_order,
-                    &mut snapshot.fluid_table,
-                )
+                .sort(&at, &mut order, &mut snapshot.fluid_table)
                 .expect("memory for the placement's sort");
-            let order = &snapshot.fluid_order;
-            snapshot.fluid = order.iter().map(|&i| positions[i as usize]).collect();
+            snapshot.fluid_order = order.iter().map(|&o| taken[o as usize]).collect();
+            snapshot.fluid = order.iter().map(|&o| at[o as usize]).collect();
         }
         moved.then_some(positions)
     }
@@ -330,12 +372,15 @@ impl World {
 
     /// For every fluid particle of `snapshot`, the multiplier λ_i of its density constraint's
     /// projection onto the movable particles (0 where it is not compressed or cannot move
-    /// anything) and its compression C_i (dimensionless).
+    /// anything) and its compression C_i (dimensionless). With `added_only`, a particle that
+    /// cannot move counts only the compression the movable particles add to what it reads
+    /// without them.
     fn placement_multipliers(
         &self,
         snapshot: &Snapshot,
         (fluid_lists, boundary_lists): (&NeighborLists, &NeighborLists),
         movable: &[bool],
+        added_only: bool,
     ) -> Vec<(f64, f64)> {
         let k = &self.constraint.kernel;
         let m = self.constraint.mass;
@@ -352,14 +397,18 @@ impl World {
                 let mut rho = m * k.w_zero();
                 let mut own = Vec3::zeros();
                 let mut others = 0.0;
+                // What the movable particles add to ρ_i (kg/m³).
+                let mut added = 0.0;
                 for &j in near {
                     let j = j as usize;
                     let r = xi - x[j];
-                    rho += m * k.w(r.norm());
+                    let w = m * k.w(r.norm());
+                    rho += w;
                     let g = (m / rest) * k.grad_w(&r);
                     own += g;
                     if movable[j] {
                         others += g.norm_squared();
+                        added += w;
                     }
                 }
                 for &q in boundary_lists.of(i) {
@@ -371,7 +420,10 @@ impl World {
                 let walls = self.constraint.walls_at(xi, &snapshot.walls);
                 rho += walls.density;
                 own += walls.gradient / rest;
-                let c = (rho / rest - 1.0).max(0.0);
+                let mut c = (rho / rest - 1.0).max(0.0);
+                if added_only && !movable[i] {
+                    c -= ((rho - added) / rest - 1.0).max(0.0);
+                }
                 let own = if movable[i] { own.norm_squared() } else { 0.0 };
                 let denominator = own + others;
                 if c == 0.0 || denominator <= 0.0 {

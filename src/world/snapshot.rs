@@ -66,16 +66,30 @@ impl World {
     /// step the boundary has no masses yet; they are then computed here as the step would,
     /// over the boundary particles there are. Panics when the memory cannot be had.
     pub(crate) fn snapshot(&self) -> Option<Snapshot> {
-        self.snapshot_with(0.0, false)
+        self.snapshot_with(0.0, false, None)
     }
 
     /// [`World::snapshot`] with a grid that reaches `margin` (m) beyond the particles, for
     /// particles that will move that far; with `bodies`, the moving bodies' particles at
     /// their current poses join the boundary with their own masses (before the first step
-    /// the boundary does not hold them yet).
-    pub(crate) fn snapshot_with(&self, margin: f64, bodies: bool) -> Option<Snapshot> {
+    /// the boundary does not hold them yet). With a `region`, only the particles inside that
+    /// box (m) are taken: the fluid's storage indices in `fluid_order` still name them.
+    pub(crate) fn snapshot_with(
+        &self,
+        margin: f64,
+        bodies: bool,
+        region: Option<&Aabb>,
+    ) -> Option<Snapshot> {
         let h = self.params.support_radius();
-        let fluid = &self.fluid.positions;
+        let within = |p: &Vec3| region.is_none_or(|r| r.contains(p, 0.0));
+        // Storage indices of the fluid taken, and their positions.
+        let taken: Vec<u32> = (0..self.fluid.len() as u32)
+            .filter(|&i| within(&self.fluid.positions[i as usize]))
+            .collect();
+        let fluid: &Vec<Vec3> = &taken
+            .iter()
+            .map(|&i| self.fluid.positions[i as usize])
+            .collect();
         let boundary = &self.boundary;
         let (mut points, known) = if bodies && boundary.has_moving() {
             let (statics, _) = boundary.statics();
@@ -127,11 +141,19 @@ impl World {
             points.push(p);
             psi.push(own);
         }
+        if region.is_some() {
+            let kept: Vec<usize> = (0..points.len()).filter(|&k| within(&points[k])).collect();
+            points = kept.iter().map(|&k| points[k]).collect();
+            psi = kept.iter().map(|&k| psi[k]).collect();
+        }
         grid.sort(fluid, &mut fluid_order, &mut fluid_table)
             .expect(OUT_OF_MEMORY);
         grid.sort(&points, &mut boundary_order, &mut boundary_table)
             .expect(OUT_OF_MEMORY);
         let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
+        for i in &mut fluid_order {
+            *i = taken[*i as usize];
+        }
         let mut bx = PointsByComponent::default();
         bx.try_permuted_from(&points_by_component(&points), &boundary_order)
             .expect(OUT_OF_MEMORY);

@@ -187,7 +187,8 @@ class World(BodiesMixin, FlowMixin):
         """Adds a static obstacle: the triangle mesh with ``vertices``, an (n, 3) array (m),
         and ``triangles``, an (m, 3) integer array of zero-based vertex indices, placed by
         ``transform`` (None: as given). Its surface is sampled with boundary particles about
-        r apart; the mesh itself is not kept."""
+        r apart. A closed mesh is also kept, so that fluid added later is not created inside
+        it (docs/method.md §2.7)."""
         v = _arrays.rows(vertices, 3, np.float32, "vertices")
         t = _arrays.indices(triangles, "triangles")
         args = (_arrays.pointer(v, c_float), len(v), _arrays.pointer(t, c_uint32), len(t))

@@ -99,7 +99,8 @@ fn add_emitter(
 /// stores its index in `*out_id`. From the start of the next step it inserts fluid
 /// particles moving at `speed` (m/s) along `direction`: a layer on a square lattice of
 /// spacing 2r over the opening each time the layer before has travelled 2r (speed × area /
-/// (2r)³ particles per second), skipping lattice points closer than 0.9 · 2r to fluid.
+/// (2r)³ particles per second), skipping lattice points closer than 0.9 · 2r to fluid or
+/// inside a solid, and settling the new particles next to walls, obstacles and bodies.
 /// `end_time` (s) is the simulated time from which no more layers are emitted; a value ≤ 0
 /// or `INFINITY` means none (the emitter runs forever). Emitted particles get new ids; see
 /// `pf_world_emitted_count`.

@@ -190,8 +190,19 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         RunLength::Steps(n) => format!("{n} steps"),
         RunLength::UntilStep(_) | RunLength::UntilTime(_) => String::new(),
     };
+    // What the fluid blocks held that placement did not create (docs/method.md §2.7).
+    let inside = match args.resume {
+        Some(_) => 0,
+        None => scene.particle_count().saturating_sub(world.fluid_count()),
+    };
+    let not_created = match inside {
+        0 => String::new(),
+        n => {
+            format!(" ({n} of the fluid blocks' particles lay inside solids and were not created)")
+        }
+    };
     eprintln!(
-        "{}: {} particles, {} boundary particles, {} solver, {goal}",
+        "{}: {} particles{not_created}, {} boundary particles, {} solver, {goal}",
         scene.name,
         world.fluid_count(),
         world.boundary_count(),

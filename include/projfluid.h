@@ -400,7 +400,10 @@ enum PfStatus pf_transform_identity(struct PfTransform *out);
  * Poisson disk with boundary particles about one particle radius r apart (no two closer
  * than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
  * always gives the same particles). Winding does not matter, and the mesh need not be
- * closed or connected; only its surface is sampled. The mesh itself is not kept.
+ * closed or connected; only its surface is sampled. A closed mesh is kept: fluid added
+ * later is not created inside it, fluid already inside it or nearer than r to its surface is
+ * removed (counted by `pf_world_removed_count`), and the fluid next to it is settled
+ * (docs/method.md §2.7).
  *
  * Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
  * limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,
@@ -771,8 +774,8 @@ enum PfStatus pf_world_remove_particles(struct PfWorld *world,
                                         size_t *removed);
 
 /**
- * Stores in `*out` the number of fluid particles removed so far: by sinks, by the domain
- * and by `pf_world_remove_particles`.
+ * Stores in `*out` the number of fluid particles removed so far: by sinks, by the domain,
+ * by `pf_world_remove_particles` and by closed solids added where fluid stood.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
@@ -991,7 +994,9 @@ enum PfStatus pf_pose_identity(struct PfPose *out);
  * whose mass and inertia it gives; for static and kinematic bodies 0 means none, and a
  * positive density only sets the centre of mass that torques are reported about (without
  * one, the centroid of the enclosed volume). Bodies start at rest; a static body never
- * moves. Fluid inside the body is not removed: place bodies clear of the fluid.
+ * moves. A closed body makes room for itself: fluid whose centre lies inside it or nearer
+ * than r to its surface is removed (counted by `pf_world_removed_count`), and the fluid next
+ * to it is settled (docs/method.md §2.7).
  *
  * Errors: `PF_ERROR_NULL_POINTER` (world, half_extents, pose or out_id NULL),
  * `PF_ERROR_INVALID_ARGUMENT` (kind not a `PfBodyKind`; a density that is negative, NaN or

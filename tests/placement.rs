@@ -3,7 +3,7 @@
 //! static and a kinematic body takes its first steps without a jolt, on one and two threads
 //! alike; fluid placed inside a solid is not created, and the adding call says how much was.
 
-use projfluid::body::{BodyKind, BodySpec, Pose, Rotation, Shape, Velocity};
+use projfluid::body::{BodyKind, BodyMass, BodySpec, Pose, Rotation, Shape, Velocity};
 use projfluid::boundary::Aabb;
 use projfluid::boundary::winding::is_inside;
 use projfluid::{Params, Vec3, World};
@@ -130,6 +130,31 @@ fn centre_height(world: &World) -> f64 {
     x.iter().map(|p| p.y).sum::<f64>() / x.len() as f64
 }
 
+/// Takes a step of `world` (`case` names it) and checks that it was calm: no iteration limit
+/// and at most 12 outer iterations; no particle faster than a fall at twice gravity plus
+/// 5 cm/s (a block resting on a solid collapses sideways under its own weight); the centre of
+/// mass not above `start_height` (m); nothing escaped.
+fn calm_step(world: &mut World, case: &str, start_height: f64) {
+    let stats = world.step().unwrap().clone();
+    assert!(
+        !stats.hit_max_iterations && stats.outer_iterations <= 12,
+        "{case}: {stats:?}"
+    );
+    let fastest = world
+        .velocities()
+        .iter()
+        .map(|v| v.norm())
+        .fold(0.0, f64::max);
+    let bound = 2.0 * 9.81 * world.time() + 0.05;
+    assert!(fastest <= bound, "{case}: {fastest} m/s > {bound} m/s");
+    let height = centre_height(world);
+    assert!(
+        height <= start_height + 1e-4,
+        "{case}: the centre of mass rose from {start_height} m to {height} m"
+    );
+    assert_eq!(world.escaped_count(), 0, "{case}");
+}
+
 /// Places the block `gap` (m) from the solid of `against` on `threads` threads, takes five
 /// steps, checks each and returns the particles' final positions.
 fn place_and_check(against: Against, gap: f64, threads: usize) -> Vec<Vec3> {
@@ -144,33 +169,13 @@ fn place_and_check(against: Against, gap: f64, threads: usize) -> Vec<Vec3> {
         "{case}: nothing lies inside a solid"
     );
     assert_eq!(world.fluid_count(), added);
-    let g = 9.81;
     let start_height = centre_height(&world);
     let container = world.containers()[0];
     for step in 1..=5 {
-        let stats = world.step().unwrap().clone();
         let case = format!("{case}, step {step}");
         // Before placement settled new fluid, these steps took 200 outer iterations (the
         // limit, twice) and threw particles at 6–90 m/s.
-        assert!(
-            !stats.hit_max_iterations && stats.outer_iterations <= 12,
-            "{case}: {stats:?}"
-        );
-        let fastest = world
-            .velocities()
-            .iter()
-            .map(|v| v.norm())
-            .fold(0.0, f64::max);
-        // A block resting on a solid collapses sideways under its own weight: no particle
-        // may be faster than a fall at twice gravity, plus 5 cm/s.
-        let bound = 2.0 * g * world.time() + 0.05;
-        assert!(fastest <= bound, "{case}: {fastest} m/s > {bound} m/s");
-        let height = centre_height(&world);
-        assert!(
-            height <= start_height + 1e-4,
-            "{case}: the centre of mass rose from {start_height} m to {height} m"
-        );
-        assert_eq!(world.escaped_count(), 0, "{case}");
+        calm_step(&mut world, &case, start_height);
         for p in world.positions() {
             assert!(container.contains(&p, 0.0), "{case}: {p:?} left the box");
             let depth = depth_in_slab(against, &p);
@@ -279,4 +284,98 @@ fn densities_before_the_first_step_are_those_where_the_fluid_stands() {
             .iter()
             .all(|&rho| rho > 0.3 * rho0 && rho < rho0 * 1.001)
     );
+}
+
+/// A closed solid added where fluid already stands makes room for itself: a closed obstacle
+/// mesh and static, kinematic and dynamic bodies put into a resting block remove the fluid
+/// whose centres lie in them or nearer than r to them (the removed count says how much) and
+/// settle the fluid next to them, so that the first steps are calm, on one and two threads alike.
+#[test]
+fn a_solid_added_into_standing_fluid_makes_room_and_the_fluid_starts_calm() {
+    // The slab, sunk into a block that stands on the container's floor, clear of the floor.
+    let sunk = Vec3::new(0.5, 0.15, 0.3);
+    for kind in [
+        None,
+        Some(BodyKind::Static),
+        Some(BodyKind::Kinematic),
+        Some(BodyKind::Dynamic),
+    ] {
+        let mut ends = Vec::new();
+        for threads in [1, 2] {
+            let mut world = World::new(Params {
+                threads,
+                ..Params::default()
+            })
+            .unwrap();
+            let tank = Aabb {
+                min: Vec3::zeros(),
+                max: Vec3::new(1.0, 0.8, 0.6),
+            };
+            world.add_container(tank, 1).unwrap();
+            // A block 16 × 6 × 10 from one spacing above the floor: 0.05–0.8 m along x.
+            world
+                .add_fluid_block(Vec3::new(0.05, 0.05, 0.05), [16, 6, 10], Vec3::zeros())
+                .unwrap();
+            let mesh = slab().mesh(R).unwrap();
+            let placed = projfluid::boundary::mesh::TriangleMesh::new(
+                mesh.vertices().iter().map(|v| v + sunk).collect(),
+                mesh.triangles().to_vec(),
+            )
+            .unwrap();
+            // Centres inside the slab or nearer than r to it.
+            let near_or_inside = |p: &Vec3| {
+                let outside: Vec3 = (p - sunk).abs() - SLAB_HALF;
+                outside.map(|e| e.max(0.0)).norm() < R
+            };
+            let inside = world
+                .positions()
+                .iter()
+                .filter(|p| near_or_inside(p))
+                .count();
+            assert!(inside > 100, "{inside}");
+            let before = world.fluid_count();
+            match kind {
+                None => world.add_boundary_mesh(&placed).unwrap(),
+                Some(kind) => {
+                    world
+                        .add_body(BodySpec {
+                            kind,
+                            mesh: mesh.clone(),
+                            mass: (kind == BodyKind::Dynamic).then_some(BodyMass::Density(800.0)),
+                            pose: Pose {
+                                position: sunk,
+                                rotation: Rotation::identity(),
+                            },
+                            velocity: Velocity::default(),
+                            motion: None,
+                        })
+                        .unwrap();
+                }
+            }
+            let case = format!("{kind:?}, {threads} threads");
+            assert_eq!(world.fluid_count(), before - inside, "{case}");
+            assert_eq!(world.removed_count(), inside as u64, "{case}");
+            let start_height = centre_height(&world);
+            for step in 1..=5 {
+                let case = format!("{case}, step {step}");
+                calm_step(&mut world, &case, start_height);
+                // The slab where it stands now (a dynamic one moves).
+                let centre = match world.bodies().first() {
+                    Some(body) => body.pose().position,
+                    None => sunk,
+                };
+                for p in world.positions() {
+                    let depth = (0..3)
+                        .map(|a| SLAB_HALF[a] - (p[a] - centre[a]).abs())
+                        .fold(f64::INFINITY, f64::min);
+                    assert!(
+                        depth < 0.2 * R,
+                        "{case}: {p:?} lies {depth} m inside the solid"
+                    );
+                }
+            }
+            ends.push(world.positions());
+        }
+        assert!(ends[0] == ends[1], "{kind:?}: thread counts differ");
+    }
 }

@@ -304,7 +304,7 @@ fn grown_lists_give_the_same_step_on_one_and_three_threads() {
 }
 
 /// A 0.6 m box holding a block of water 0.4 m × 0.25 m × 0.4 m, a dynamic cube falling into
-/// it and a kinematic paddle pushed into it, stepped by the LDLᵀ solver on a pool of
+/// it, a kinematic paddle pushed into it and an inlet in a wall pouring in, stepped by the LDLᵀ solver on a pool of
 /// `threads` threads whose allocations [`COUNTDOWN`] counts.
 fn bodies_world(threads: usize) -> World {
     let pool = rayon::ThreadPoolBuilder::new()
@@ -356,6 +356,17 @@ fn bodies_world(threads: usize) -> World {
         Vec3::new(0.3, 0.0, 0.0),
     );
     world.add_body(paddle).unwrap();
+    // An inlet in the wall above the water, whose layers are settled against the wall.
+    let inlet = EmitterSpec {
+        shape: EmitterShape::Rectangle {
+            half_extents: [0.05, 0.05],
+        },
+        position: Vec3::new(0.6, 0.45, 0.3),
+        direction: Vec3::new(-1.0, 0.0, 0.0),
+        speed: 0.5,
+        end_time: None,
+    };
+    world.add_emitter(inlet).unwrap();
     world
 }
 

@@ -189,7 +189,9 @@ fn add_body(
 /// whose mass and inertia it gives; for static and kinematic bodies 0 means none, and a
 /// positive density only sets the centre of mass that torques are reported about (without
 /// one, the centroid of the enclosed volume). Bodies start at rest; a static body never
-/// moves. Fluid inside the body is not removed: place bodies clear of the fluid.
+/// moves. A closed body makes room for itself: fluid whose centre lies inside it or nearer
+/// than r to its surface is removed (counted by `pf_world_removed_count`), and the fluid next
+/// to it is settled (docs/method.md §2.7).
 ///
 /// Errors: `PF_ERROR_NULL_POINTER` (world, half_extents, pose or out_id NULL),
 /// `PF_ERROR_INVALID_ARGUMENT` (kind not a `PfBodyKind`; a density that is negative, NaN or

@@ -72,7 +72,10 @@ fn read_transform(args: Args, transform: *const PfTransform) -> Result<Transform
 /// Poisson disk with boundary particles about one particle radius r apart (no two closer
 /// than r, no surface point farther than about 1.4·r from one), reproducibly (the same mesh
 /// always gives the same particles). Winding does not matter, and the mesh need not be
-/// closed or connected; only its surface is sampled. The mesh itself is not kept.
+/// closed or connected; only its surface is sampled. A closed mesh is kept: fluid added
+/// later is not created inside it, fluid already inside it or nearer than r to its surface is
+/// removed (counted by `pf_world_removed_count`), and the fluid next to it is settled
+/// (docs/method.md §2.7).
 ///
 /// Errors: `PF_ERROR_NULL_POINTER`, `PF_ERROR_INVALID_ARGUMENT` (a count of 0 or above the
 /// limit; a non-finite vertex, named as `vertices[i]`; an index not below vertex_count,

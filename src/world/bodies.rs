@@ -5,6 +5,7 @@ use super::{MAX_PARTICLES, World};
 use crate::body::{Body, BodyKind, BodySpec, Pose, Velocity, inset};
 use crate::boundary::mesh::{sample_count_bound, sample_poisson_disk};
 use crate::boundary::own_masses;
+use crate::boundary::winding::is_closed_and_oriented;
 use crate::{Error, Vec3};
 
 /// Most boundary particles one body may have.
@@ -23,7 +24,9 @@ impl World {
     /// leaving the world unchanged, on a bad spec (named field), a mesh that is far larger
     /// than r or gives no particles, or the particle limit.
     ///
-    /// Fluid inside the body is not removed: place bodies clear of the fluid.
+    /// A closed body makes room for itself (docs/method.md §2.7): fluid whose centre lies
+    /// inside it is removed (see [`World::removed_count`]), and the fluid next to it is
+    /// moved out of it and settled.
     pub fn add_body(&mut self, spec: BodySpec) -> Result<BodyId, Error> {
         let r = self.params.particle_radius;
         let bounds = spec.mesh.bounds();
@@ -76,7 +79,11 @@ impl World {
             self.boundary.add_static(&placed, owner);
         }
         self.boundary.set_moving(owner, body.moves());
+        let closed = is_closed_and_oriented(&body.mesh).then(|| body.placed_mesh());
         self.bodies.push(body);
+        if let Some(placed) = closed {
+            self.displace_fluid(&placed);
+        }
         Ok(id)
     }
 

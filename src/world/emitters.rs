@@ -1,7 +1,6 @@
 //! Emitters in a world (docs/method.md §12.2): adding them, and inserting their due layers
 //! at the start of a step.
 
-use super::placement::Settling;
 use super::{MAX_PARTICLES, World};
 use crate::Error;
 use crate::emitter::{Emitter, EmitterSpec, EmitterState};
@@ -83,7 +82,7 @@ impl World {
         if self.emitters.is_empty() {
             return Ok(());
         }
-        let first = self.fluid.next_id;
+        let first = self.fluid.len();
         let mut solids = None;
         let (mut offsets, mut blocked, mut points) = (Vec::new(), Vec::new(), Vec::new());
         for e in 0..self.emitters.len() {
@@ -108,10 +107,10 @@ impl World {
             self.fluid
                 .push(&points, std::iter::repeat_n(velocity, points.len()));
         }
-        if let Some(solids) = solids.filter(|_| self.fluid.next_id > first) {
-            self.settle_new_fluid(first, solids, Settling::Emitted);
+        match solids.filter(|_| self.fluid.len() > first) {
+            Some(solids) => self.settle_emitted(first, &solids),
+            None => Ok(()),
         }
-        Ok(())
     }
 
     /// Adds a step of `dt` seconds to every emitter's travel.

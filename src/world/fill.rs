@@ -317,7 +317,10 @@ impl World {
     /// minimum distance of one particle radius r (see [`sample_poisson_disk`]), the samples
     /// added as boundary particles. Their Akinci volumes are computed before the next step.
     /// Winding does not matter and the mesh need not be closed; only the surface is sampled,
-    /// one layer thick. Errors, leaving the world unchanged, when the mesh is far larger than r
+    /// one layer thick. A closed mesh is kept, so that fluid added later is not created
+    /// inside it, and makes room for itself (docs/method.md §2.7): fluid whose centre lies
+    /// inside it is removed (see [`World::removed_count`]), and the fluid next to it is moved
+    /// out of it and settled. Errors, leaving the world unchanged, when the mesh is far larger than r
     /// (an extent above 10⁶·r or more than about 5·10⁷ samples), the boundary particle
     /// limit would be exceeded, or ([`Error::OutOfMemory`]) the memory the sampling needs
     /// cannot be had when the call starts.
@@ -354,6 +357,7 @@ impl World {
         self.add_boundary_particles(&samples)?;
         if closed {
             self.obstacles.push(mesh.clone());
+            self.displace_fluid(mesh);
         }
         Ok(())
     }

@@ -12,6 +12,7 @@ use crate::boundary::mesh::TriangleMesh;
 use crate::boundary::winding::{is_closed_and_oriented, winding_number};
 use crate::neighbors::NeighborLists;
 use rayon::prelude::*;
+use std::collections::TryReserveError;
 
 /// The placement projection stops once no constraint of the fluid is compressed by more
 /// than this fraction of ρ0: what is left turns into velocities of a few mm/s in the first
@@ -33,6 +34,9 @@ const PLACEMENT_STEP: f64 = 0.25;
 /// and what a wall beside it compresses is gone in a few passes.
 const EMISSION_PASSES: usize = 40;
 
+/// The storage indices of the fluid a local projection took, and their positions (m) after it.
+type SettledNear = (Vec<u32>, Vec<Vec3>);
+
 /// How [`World::settle_new_fluid`] settles new fluid.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Settling {
@@ -42,9 +46,8 @@ pub(super) enum Settling {
     /// Also projects every compression near the new particles away on their positions, over
     /// the whole world, and evaluates the densities frames report before the first step.
     Block,
-    /// Also projects the new particles' own compressions away, within reach of them, in at
-    /// most [`EMISSION_PASSES`] passes: an emitter's layers, inserted at the start of a step
-    /// into fluid that is moving.
+    /// An emitter's layers, inserted at the start of a step into fluid that is moving: see
+    /// [`World::settle_emitted`].
     Emitted,
 }
 
@@ -120,6 +123,15 @@ fn nearest_on_triangle(p: &Vec3, [a, b, c]: [Vec3; 3]) -> Vec3 {
     a + ab * (vb * denominator) + ac * (vc * denominator)
 }
 
+/// The distance (m) from `p` (m) to the nearest point of `mesh`'s surface.
+fn distance_to_mesh(p: &Vec3, mesh: &TriangleMesh) -> f64 {
+    let vertices = mesh.vertices();
+    mesh.triangles()
+        .iter()
+        .map(|t| (p - nearest_on_triangle(p, t.map(|i| vertices[i as usize]))).norm())
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// Moves `p` (m), outside the closed `mesh` or on it, to at least `r` (m) from its surface,
 /// straight away from the nearest surface point (along the nearest triangle's outward normal
 /// where `p` lies on the surface).
@@ -152,6 +164,29 @@ fn clear_of_mesh(p: &mut Vec3, mesh: &TriangleMesh, r: f64) {
         }
     };
     *p = q + away * r;
+}
+
+/// Moves the particles of `positions` (m) marked in `movable` out to `r` (m) from the walls
+/// of their holding containers in `holders` and from the closed meshes of `solids`.
+fn clear_of_solids(
+    positions: &mut [Vec3],
+    holders: &[Option<Aabb>],
+    movable: &[bool],
+    solids: &Solids,
+    r: f64,
+) {
+    clear_of_walls(positions, holders, r);
+    for (mesh, bounds) in &solids.closed {
+        let reach = Aabb {
+            min: bounds.min - Vec3::repeat(r),
+            max: bounds.max + Vec3::repeat(r),
+        };
+        positions
+            .par_iter_mut()
+            .zip(movable)
+            .filter(|(p, free)| **free && reach.contains(p, 0.0))
+            .for_each(|(p, _)| clear_of_mesh(p, mesh, r));
+    }
 }
 
 /// Moves every particle of `positions` (m) that has a holding container in `holders` to at
@@ -192,126 +227,239 @@ impl World {
         }
     }
 
-    /// Settles the fluid particles whose ids are `first_id` or later, just added among
-    /// `solids` (the world's, as [`World::solids`] gave them): moves those nearer than r to a
-    /// wall of the container that holds them, or to a closed obstacle or body, out to r (and
-    /// keeps them there while it projects), then, as `settling` says, projects the density
-    /// constraints on the new particles' positions alone until none is compressed by more
-    /// than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a lattice block reads at the
-    /// world's mass factor (or the passes run out). Velocities and the particles added before
-    /// stay as they are.
+    /// Settles the fluid particles whose ids are `first_id` or later, just added between
+    /// steps among `solids` (the world's, as [`World::solids`] gave them): moves those nearer
+    /// than r to a wall of the container that holds them, or to a closed obstacle or body, out
+    /// to r (and keeps them there while it projects); with [`Settling::Block`] it then projects
+    /// the density constraints of every particle near them on their positions alone until
+    /// none is compressed by more than [`PLACEMENT_TOLERANCE`] beyond what the bulk of a
+    /// lattice block reads at the world's mass factor (or [`PLACEMENT_PASSES`] have run), and
+    /// evaluates every particle's density where it stands, as frames and reads report it until
+    /// the next step. Velocities and the particles added before stay as they are.
     ///
     /// # Panics
     /// When the memory for the neighbour search cannot be had (as the readings between steps).
     pub(super) fn settle_new_fluid(&mut self, first_id: u64, solids: Solids, settling: Settling) {
-        let r = self.params.particle_radius;
         let holders: Vec<Option<Aabb>> = self
             .fluid
             .positions
             .iter()
             .zip(&self.fluid.ids)
-            .map(|(p, &id)| {
-                let holder = self.containers.iter().find(|c| c.contains(p, 0.0));
-                holder.filter(|_| id >= first_id).copied()
-            })
+            .map(|(p, &id)| self.holder(p).filter(|_| id >= first_id))
             .collect();
-        let closed = solids.closed;
         let movable: Vec<bool> = self.fluid.ids.iter().map(|&id| id >= first_id).collect();
-        let clear = |positions: &mut [Vec3]| {
-            clear_of_walls(positions, &holders, r);
-            for (mesh, bounds) in &closed {
-                let reach = Aabb {
-                    min: bounds.min - Vec3::repeat(r),
-                    max: bounds.max + Vec3::repeat(r),
-                };
-                positions
-                    .par_iter_mut()
-                    .zip(&movable)
-                    .filter(|(p, free)| **free && reach.contains(p, 0.0))
-                    .for_each(|(p, _)| clear_of_mesh(p, mesh, r));
-            }
-        };
+        self.settle(&movable, &holders, &solids, settling);
+    }
+
+    /// Makes room for the closed solid `mesh` (m, where it stands), just added to the world's
+    /// solids: removes the fluid particles whose centres lie inside it or nearer than r to its
+    /// surface (counted by [`World::removed_count`]) and projects what the solid compresses
+    /// away on the positions of the fluid within H of it, as
+    /// [`World::settle_new_fluid`] does for a block. Returns how many particles it removed.
+    ///
+    /// # Panics
+    /// When the memory for the neighbour search cannot be had (as the readings between steps).
+    pub(super) fn displace_fluid(&mut self, mesh: &TriangleMesh) -> usize {
+        let bounds = mesh.bounds();
+        let r = self.params.particle_radius;
+        // A centre nearer than r to the surface would have to move out to r, crowding the
+        // fluid beyond: its particle goes with those inside.
+        let removed = self.fluid.remove_where(|p, _| {
+            bounds.contains(p, r) && (inside(mesh, p) || distance_to_mesh(p, mesh) < r)
+        });
+        let h = self.params.support_radius();
+        let movable: Vec<bool> = self
+            .fluid
+            .positions
+            .iter()
+            .map(|p| bounds.contains(p, h))
+            .collect();
+        if movable.iter().any(|&m| m) {
+            let holders = vec![None; movable.len()];
+            let solids = self.solids();
+            self.settle(&movable, &holders, &solids, Settling::Block);
+        }
+        removed
+    }
+
+    /// What [`World::settle_new_fluid`] does, for the particles marked in `movable` (in storage
+    /// order), kept clear of the walls of their containers in `holders`.
+    fn settle(
+        &mut self,
+        movable: &[bool],
+        holders: &[Option<Aabb>],
+        solids: &Solids,
+        settling: Settling,
+    ) {
+        let r = self.params.particle_radius;
+        let clear =
+            |positions: &mut [Vec3]| clear_of_solids(positions, holders, movable, solids, r);
         self.pool.install(|| clear(&mut self.fluid.positions));
         if settling == Settling::Clear {
             return;
         }
-        let settled = self
-            .pool
-            .install(|| self.placement_projection(&movable, &clear, settling));
+        let h = self.params.support_radius();
+        let settled = self.pool.install(|| {
+            let snapshot = self.snapshot_with(h, true)?;
+            let positions = self.fluid.positions.clone();
+            self.placement_projection(snapshot, positions, movable, &clear, Settling::Block)
+                .expect("memory for the placement's neighbour search")
+        });
         if let Some(settled) = settled {
             self.fluid.positions = settled;
         }
-        if settling == Settling::Block {
-            self.fluid.densities = self.densities_now();
-        }
+        self.fluid.densities = self.densities_now();
     }
 
-    /// The fluid's positions (m, in storage order) after the passes of
-    /// [`World::settle_new_fluid`]'s projection of the particles marked in `movable` (in
-    /// storage order), or `None` where nothing was compressed.
-    /// Runs on the caller's pool.
+    /// Settles the particles an emitter inserted at the start of a step, those stored from
+    /// index `first` on, among `solids`: moves them out of the walls as
+    /// [`World::settle_new_fluid`] does and projects their own compressions, and what they
+    /// add to the fluid's, away on their positions, within reach of them and in at most
+    /// [`EMISSION_PASSES`] passes. Errors when memory cannot be had, with the new particles
+    /// part-way (the caller removes them).
+    pub(super) fn settle_emitted(
+        &mut self,
+        first: usize,
+        solids: &Solids,
+    ) -> Result<(), TryReserveError> {
+        let r = self.params.particle_radius;
+        let count = self.fluid.len() - first;
+        let mut holders = Vec::new();
+        holders.try_reserve_exact(count)?;
+        holders.extend(self.fluid.positions[first..].iter().map(|p| self.holder(p)));
+        let mut all = Vec::new();
+        all.try_reserve_exact(count)?;
+        all.resize(count, true);
+        self.pool.install(|| {
+            clear_of_solids(
+                &mut self.fluid.positions[first..],
+                &holders,
+                &all,
+                solids,
+                r,
+            )
+        });
+        let world = &*self;
+        let settled = world
+            .pool
+            .install(|| world.emission_projection(first, &holders, solids))?;
+        if let Some((taken, settled)) = settled {
+            for (&i, p) in taken.iter().zip(settled) {
+                if i as usize >= first {
+                    self.fluid.positions[i as usize] = p;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// For [`World::settle_emitted`], on the world's pool: the storage indices of the fluid
+    /// within reach of the new particles (stored from index `first` on, held by `holders`),
+    /// with their positions after the projection, or `None` where nothing was compressed.
+    fn emission_projection(
+        &self,
+        first: usize,
+        holders: &[Option<Aabb>],
+        solids: &Solids,
+    ) -> Result<Option<SettledNear>, TryReserveError> {
+        let r = self.params.particle_radius;
+        let step = PLACEMENT_STEP * r;
+        let h = self.params.support_radius();
+        let Some(around) = Aabb::around(&self.fluid.positions[first..]) else {
+            return Ok(None);
+        };
+        // The new particles, the fluid they can reach in the passes there are, and that
+        // fluid's neighbours.
+        let reach = Vec3::repeat(2.0 * h + EMISSION_PASSES as f64 * step);
+        let region = Aabb {
+            min: around.min - reach,
+            max: around.max + reach,
+        };
+        let Some((snapshot, taken)) = self.snapshot_near(&region, h)? else {
+            return Ok(None);
+        };
+        let mut positions = Vec::new();
+        positions.try_reserve_exact(taken.len())?;
+        positions.extend(taken.iter().map(|&i| self.fluid.positions[i as usize]));
+        let mut movable = Vec::new();
+        movable.try_reserve_exact(taken.len())?;
+        movable.extend(taken.iter().map(|&i| i as usize >= first));
+        let mut local_holders = Vec::new();
+        local_holders.try_reserve_exact(taken.len())?;
+        local_holders.extend(
+            taken
+                .iter()
+                .map(|&i| (i as usize).checked_sub(first).and_then(|k| holders[k])),
+        );
+        let clear = |positions: &mut [Vec3]| {
+            clear_of_solids(positions, &local_holders, &movable, solids, r)
+        };
+        let settled =
+            self.placement_projection(snapshot, positions, &movable, &clear, Settling::Emitted)?;
+        Ok(settled.map(|settled| (taken, settled)))
+    }
+
+    /// The container box that holds `p` (m), the first of them, if any.
+    fn holder(&self, p: &Vec3) -> Option<Aabb> {
+        self.containers.iter().find(|c| c.contains(p, 0.0)).copied()
+    }
+
+    /// `positions` (m, indexed as the snapshot's `fluid_order` indexes) after the passes of
+    /// the placement projection of the particles marked in `movable` (indexed alike) over
+    /// `snapshot`, or `None` where nothing was compressed. With [`Settling::Emitted`] the
+    /// passes are fewer and the particles that cannot move count only the compression the
+    /// movable ones add. Runs on the caller's pool; errors when memory cannot be had.
     fn placement_projection(
         &self,
+        mut snapshot: Snapshot,
+        mut positions: Vec<Vec3>,
         movable: &[bool],
         clear: &(dyn Fn(&mut [Vec3]) + Sync),
         settling: Settling,
-    ) -> Option<Vec<Vec3>> {
+    ) -> Result<Option<Vec<Vec3>>, TryReserveError> {
         let h = self.params.support_radius();
         let step = PLACEMENT_STEP * self.params.particle_radius;
-        let (passes, region) = match settling {
-            Settling::Emitted => {
-                // The new particles, the fluid they can reach in the passes there are, and
-                // that fluid's neighbours.
-                let new = (0..movable.len())
-                    .filter(|&i| movable[i])
-                    .map(|i| self.fluid.positions[i]);
-                let reach = Vec3::repeat(2.0 * h + EMISSION_PASSES as f64 * step);
-                let around = Aabb::enclosing(new)?;
-                let region = Aabb {
-                    min: around.min - reach,
-                    max: around.max + reach,
-                };
-                (EMISSION_PASSES, Some(region))
-            }
-            _ => (PLACEMENT_PASSES, None),
+        // Fluid moving through a step reads compressions of its own, which emitted
+        // particles are not to chase: they answer only for what they add.
+        let (passes, added_only) = match settling {
+            Settling::Emitted => (EMISSION_PASSES, true),
+            _ => (PLACEMENT_PASSES, false),
         };
-        let mut snapshot = self.snapshot_with(h, true, region.as_ref())?;
         // What the lattice itself reads is the mass factor's choice, not placement's to undo.
         let tolerance = PLACEMENT_TOLERANCE + self.lattice_compression();
-        let mut positions = self.fluid.positions.clone();
         let rest = self.constraint.rest_density;
         let (k, m) = (&self.constraint.kernel, self.constraint.mass);
         let (mut fluid_lists, mut boundary_lists) =
             (NeighborLists::default(), NeighborLists::default());
-        // The storage indices of the fluid the snapshot holds, and their positions.
-        let mut taken = snapshot.fluid_order.clone();
-        taken.sort_unstable();
-        let mut at: Vec<Vec3> = Vec::with_capacity(taken.len());
-        let mut order = Vec::new();
+        let n = snapshot.fluid.len();
+        let (mut free, mut lambdas, mut moves) = (Vec::new(), Vec::new(), Vec::new());
+        free.try_reserve_exact(n)?;
+        lambdas.try_reserve_exact(n)?;
+        moves.try_reserve_exact(n)?;
         let mut moved = false;
         for _ in 0..passes {
             let x = &snapshot.fluid;
-            let free: Vec<bool> = snapshot
-                .fluid_order
-                .iter()
-                .map(|&i| movable[i as usize])
-                .collect();
+            free.clear();
+            free.extend(snapshot.fluid_order.iter().map(|&i| movable[i as usize]));
             snapshot
                 .grid
-                .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists)
-                .expect("memory for the placement's neighbour search");
-            snapshot.boundary_near(x, h, &mut boundary_lists);
+                .search(&snapshot.fluid_table, x, x, h, true, &mut fluid_lists)?;
+            snapshot.grid.search_in(
+                &snapshot.boundary_table,
+                &snapshot.boundary,
+                x,
+                h,
+                false,
+                &mut boundary_lists,
+            )?;
             let lists = (&fluid_lists, &boundary_lists);
-            // Fluid moving through a step reads compressions of its own, which emitted
-            // particles are not to chase: they answer only for what they add.
-            let added_only = settling == Settling::Emitted;
-            let lambdas = self.placement_multipliers(&snapshot, lists, &free, added_only);
+            self.placement_multipliers(&snapshot, lists, &free, added_only, &mut lambdas);
             let worst = lambdas.iter().map(|l| l.1).fold(0.0, f64::max);
             if worst <= tolerance {
                 break;
             }
             moved = true;
-            let moves: Vec<Vec3> = (0..x.len())
+            (0..x.len())
                 .into_par_iter()
                 .map(|j| {
                     if !free[j] {
@@ -340,21 +488,23 @@ impl World {
                     let len = d.norm();
                     if len > step { d * (step / len) } else { d }
                 })
-                .collect();
+                .collect_into_vec(&mut moves);
             for ((p, d), &i) in x.iter().zip(&moves).zip(&snapshot.fluid_order) {
                 positions[i as usize] = p + d;
             }
             clear(&mut positions);
-            at.clear();
-            at.extend(taken.iter().map(|&i| positions[i as usize]));
+            snapshot.grid.sort(
+                &positions,
+                &mut snapshot.fluid_order,
+                &mut snapshot.fluid_table,
+            )?;
+            let order = &snapshot.fluid_order;
+            snapshot.fluid.clear();
             snapshot
-                .grid
-                .sort(&at, &mut order, &mut snapshot.fluid_table)
-                .expect("memory for the placement's sort");
-            snapshot.fluid_order = order.iter().map(|&o| taken[o as usize]).collect();
-            snapshot.fluid = order.iter().map(|&o| at[o as usize]).collect();
+                .fluid
+                .extend(order.iter().map(|&i| positions[i as usize]));
         }
-        moved.then_some(positions)
+        Ok(moved.then_some(positions))
     }
 
     /// The compression (dimensionless, ≥ 0) of the bulk of a lattice block of spacing 2r:
@@ -374,14 +524,15 @@ impl World {
     /// projection onto the movable particles (0 where it is not compressed or cannot move
     /// anything) and its compression C_i (dimensionless). With `added_only`, a particle that
     /// cannot move counts only the compression the movable particles add to what it reads
-    /// without them.
+    /// without them. Writes them into `out`, which holds room for them.
     fn placement_multipliers(
         &self,
         snapshot: &Snapshot,
         (fluid_lists, boundary_lists): (&NeighborLists, &NeighborLists),
         movable: &[bool],
         added_only: bool,
-    ) -> Vec<(f64, f64)> {
+        out: &mut Vec<(f64, f64)>,
+    ) {
         let k = &self.constraint.kernel;
         let m = self.constraint.mass;
         let rest = self.constraint.rest_density;
@@ -432,6 +583,6 @@ impl World {
                     (-c / (denominator + 1e-6), c)
                 }
             })
-            .collect()
+            .collect_into_vec(out);
     }
 }

@@ -52,8 +52,8 @@ impl World {
         self.domain.as_ref()
     }
 
-    /// Fluid particles removed so far: by sinks, by the domain and by
-    /// [`World::remove_particles`].
+    /// Fluid particles removed so far: by sinks, by the domain, by
+    /// [`World::remove_particles`] and by closed solids added where fluid stood.
     pub fn removed_count(&self) -> u64 {
         self.fluid.removed
     }

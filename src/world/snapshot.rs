@@ -7,6 +7,7 @@ use crate::Vec3;
 use crate::boundary::{Aabb, WallField, akinci_volumes};
 use crate::constraint::Neighborhood;
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
+use std::collections::TryReserveError;
 
 /// What a reading between steps panics with when its memory cannot be had: such readings
 /// (densities, pressures, probes) serve the Rust API and the tools, not the C API.
@@ -53,6 +54,15 @@ impl Snapshot {
     }
 }
 
+/// The items of `items` in a vector of exactly their number, or the error when it cannot be
+/// had (`items` is walked twice).
+fn try_collect<T>(items: impl Iterator<Item = T> + Clone) -> Result<Vec<T>, TryReserveError> {
+    let mut out = Vec::new();
+    out.try_reserve_exact(items.clone().count())?;
+    out.extend(items);
+    Ok(out)
+}
+
 /// `points` (m) held by component.
 fn points_by_component(points: &[Vec3]) -> PointsByComponent {
     let mut out = PointsByComponent::default();
@@ -66,30 +76,16 @@ impl World {
     /// step the boundary has no masses yet; they are then computed here as the step would,
     /// over the boundary particles there are. Panics when the memory cannot be had.
     pub(crate) fn snapshot(&self) -> Option<Snapshot> {
-        self.snapshot_with(0.0, false, None)
+        self.snapshot_with(0.0, false)
     }
 
     /// [`World::snapshot`] with a grid that reaches `margin` (m) beyond the particles, for
     /// particles that will move that far; with `bodies`, the moving bodies' particles at
     /// their current poses join the boundary with their own masses (before the first step
-    /// the boundary does not hold them yet). With a `region`, only the particles inside that
-    /// box (m) are taken: the fluid's storage indices in `fluid_order` still name them.
-    pub(crate) fn snapshot_with(
-        &self,
-        margin: f64,
-        bodies: bool,
-        region: Option<&Aabb>,
-    ) -> Option<Snapshot> {
+    /// the boundary does not hold them yet).
+    pub(crate) fn snapshot_with(&self, margin: f64, bodies: bool) -> Option<Snapshot> {
         let h = self.params.support_radius();
-        let within = |p: &Vec3| region.is_none_or(|r| r.contains(p, 0.0));
-        // Storage indices of the fluid taken, and their positions.
-        let taken: Vec<u32> = (0..self.fluid.len() as u32)
-            .filter(|&i| within(&self.fluid.positions[i as usize]))
-            .collect();
-        let fluid: &Vec<Vec3> = &taken
-            .iter()
-            .map(|&i| self.fluid.positions[i as usize])
-            .collect();
+        let fluid = &self.fluid.positions;
         let boundary = &self.boundary;
         let (mut points, known) = if bodies && boundary.has_moving() {
             let (statics, _) = boundary.statics();
@@ -115,14 +111,13 @@ impl World {
         let pad = Vec3::repeat(margin);
         let grid =
             UniformGrid::covering(bounds.min - pad, bounds.max + pad, h).expect(OUT_OF_MEMORY);
-        let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
-        let (mut fluid_order, mut boundary_order) = (Vec::new(), Vec::new());
         let mut psi = match known.filter(|_| !boundary.dirty) {
             Some(psi) => psi,
             None => {
                 // Akinci volumes over the static particles (docs/method.md §2.6).
                 let mut bx = PointsByComponent::default();
                 let mut order = Vec::new();
+                let mut boundary_table = CellTable::default();
                 grid.sort(&points, &mut order, &mut boundary_table)
                     .expect(OUT_OF_MEMORY);
                 bx.try_permuted_from(&points_by_component(&points), &order)
@@ -141,32 +136,120 @@ impl World {
             points.push(p);
             psi.push(own);
         }
-        if region.is_some() {
-            let kept: Vec<usize> = (0..points.len()).filter(|&k| within(&points[k])).collect();
-            points = kept.iter().map(|&k| points[k]).collect();
-            psi = kept.iter().map(|&k| psi[k]).collect();
+        Some(
+            self.sorted(grid, fluid, &points, &psi)
+                .expect(OUT_OF_MEMORY),
+        )
+    }
+
+    /// The fluid within `region` (m) and the boundary within reach of it, sorted into a grid
+    /// of their own that reaches `margin` (m) beyond the region, the moving bodies' particles
+    /// at their current poses included with their own masses; and the storage index of each
+    /// fluid particle taken. `fluid_order` of the snapshot indexes that list, not the storage.
+    /// Where the boundary's masses are not known yet, those of the static particles within
+    /// reach are computed from their neighbours as a step would. `None` when no fluid lies in
+    /// the region; errors, changing nothing, when memory cannot be had.
+    pub(crate) fn snapshot_near(
+        &self,
+        region: &Aabb,
+        margin: f64,
+    ) -> Result<Option<(Snapshot, Vec<u32>)>, TryReserveError> {
+        let h = self.params.support_radius();
+        let grow = |b: &Aabb, by: f64| Aabb {
+            min: b.min - Vec3::repeat(by),
+            max: b.max + Vec3::repeat(by),
+        };
+        // Boundary particles within h of the region reach its fluid; their masses need their
+        // own neighbours, within h of them.
+        let (reach, wide) = (grow(region, h), grow(region, 2.0 * h));
+        let positions = &self.fluid.positions;
+        let taken = try_collect(
+            (0..positions.len() as u32).filter(|&i| region.contains(&positions[i as usize], 0.0)),
+        )?;
+        if taken.is_empty() {
+            return Ok(None);
         }
-        grid.sort(fluid, &mut fluid_order, &mut fluid_table)
-            .expect(OUT_OF_MEMORY);
-        grid.sort(&points, &mut boundary_order, &mut boundary_table)
-            .expect(OUT_OF_MEMORY);
-        let fluid: Vec<Vec3> = fluid_order.iter().map(|&i| fluid[i as usize]).collect();
-        for i in &mut fluid_order {
-            *i = taken[*i as usize];
+        let fluid = try_collect(taken.iter().map(|&i| positions[i as usize]))?;
+        let boundary = &self.boundary;
+        let moving = boundary.has_moving();
+        let statics = |within: Aabb| {
+            (0..boundary.len()).filter(move |&k| {
+                !(moving && boundary.is_moving_particle(k))
+                    && within.contains(&boundary.positions.at(k), 0.0)
+            })
+        };
+        let grid_box = grow(region, 2.0 * h + margin);
+        let grid = UniformGrid::covering(grid_box.min, grid_box.max, h)?;
+        let (mut points, mut psi) = if boundary.psi.len() == boundary.len() && !boundary.dirty {
+            let points = try_collect(statics(reach).map(|k| boundary.positions.at(k)))?;
+            (
+                points,
+                try_collect(statics(reach).map(|k| boundary.psi[k]))?,
+            )
+        } else {
+            // Akinci volumes (docs/method.md §2.6) over the static particles near the region.
+            let near = try_collect(statics(wide).map(|k| boundary.positions.at(k)))?;
+            let mut table = CellTable::default();
+            let mut order = Vec::new();
+            grid.sort(&near, &mut order, &mut table)?;
+            let mut bx = PointsByComponent::default();
+            let mut by_component = PointsByComponent::default();
+            by_component.fill(&near)?;
+            bx.try_permuted_from(&by_component, &order)?;
+            let volumes = akinci_volumes(&grid, &table, &bx, &self.constraint.kernel)?;
+            let mut psi = try_collect(std::iter::repeat_n(0.0, near.len()))?;
+            for (&k, v) in order.iter().zip(volumes) {
+                psi[k as usize] = v * self.params.rest_density;
+            }
+            let kept = |k: &usize| reach.contains(&near[*k], 0.0);
+            let points = try_collect((0..near.len()).filter(kept).map(|k| near[k]))?;
+            (
+                points,
+                try_collect((0..near.len()).filter(kept).map(|k| psi[k]))?,
+            )
+        };
+        for (p, own) in self.moving_body_particles(true) {
+            if reach.contains(&p, 0.0) {
+                points.try_reserve(1)?;
+                psi.try_reserve(1)?;
+                points.push(p);
+                psi.push(own);
+            }
         }
+        Ok(Some((self.sorted(grid, &fluid, &points, &psi)?, taken)))
+    }
+
+    /// The fluid at `fluid` and the boundary at `points` with masses `psi` (kg) sorted into
+    /// `grid`.
+    fn sorted(
+        &self,
+        grid: UniformGrid,
+        fluid: &[Vec3],
+        points: &[Vec3],
+        psi: &[f64],
+    ) -> Result<Snapshot, TryReserveError> {
+        let (mut fluid_table, mut boundary_table) = (CellTable::default(), CellTable::default());
+        let (mut fluid_order, mut boundary_order) = (Vec::new(), Vec::new());
+        grid.sort(fluid, &mut fluid_order, &mut fluid_table)?;
+        grid.sort(points, &mut boundary_order, &mut boundary_table)?;
+        let sorted_fluid = try_collect(fluid_order.iter().map(|&i| fluid[i as usize]))?;
+        let mut by_component = PointsByComponent::default();
+        by_component.fill(points)?;
         let mut bx = PointsByComponent::default();
-        bx.try_permuted_from(&points_by_component(&points), &boundary_order)
-            .expect(OUT_OF_MEMORY);
-        let psi = boundary_order.iter().map(|&i| psi[i as usize]).collect();
-        Some(Snapshot {
+        bx.try_permuted_from(&by_component, &boundary_order)?;
+        let psi = try_collect(boundary_order.iter().map(|&i| psi[i as usize]))?;
+        let mut walls = Vec::new();
+        walls.try_reserve_exact(self.boundary.walls.len())?;
+        walls.extend(self.boundary.walls.iter().cloned());
+        Ok(Snapshot {
             grid,
             fluid_table,
-            fluid,
+            fluid: sorted_fluid,
             fluid_order,
             boundary_table,
             boundary: bx,
             psi,
-            walls: boundary.walls.clone(),
+            walls,
         })
     }
 

@@ -124,5 +124,6 @@ class FlowMixin:
 
     @property
     def removed_count(self) -> int:
-        """Particles removed so far (by sinks, the domain and by id)."""
+        """Particles removed so far (by sinks, the domain, by id and by closed solids added
+        where fluid stood)."""
         return self._u64(lib.pf_world_removed_count)

@@ -188,7 +188,8 @@ class World(BodiesMixin, FlowMixin):
         and ``triangles``, an (m, 3) integer array of zero-based vertex indices, placed by
         ``transform`` (None: as given). Its surface is sampled with boundary particles about
         r apart. A closed mesh is also kept, so that fluid added later is not created inside
-        it (docs/method.md §2.7)."""
+        it; fluid already inside it or nearer than r to its surface is removed (see
+        ``removed_count``) and the fluid next to it is settled (docs/method.md §2.7)."""
         v = _arrays.rows(vertices, 3, np.float32, "vertices")
         t = _arrays.indices(triangles, "triangles")
         args = (_arrays.pointer(v, c_float), len(v), _arrays.pointer(t, c_uint32), len(t))

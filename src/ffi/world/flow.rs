@@ -284,8 +284,8 @@ pub unsafe extern "C" fn pf_world_remove_particles(
     })
 }
 
-/// Stores in `*out` the number of fluid particles removed so far: by sinks, by the domain
-/// and by `pf_world_remove_particles`.
+/// Stores in `*out` the number of fluid particles removed so far: by sinks, by the domain,
+/// by `pf_world_remove_particles` and by closed solids added where fluid stood.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.

@@ -19,6 +19,7 @@ pub(super) const NAMES: &[&str] = &[
     "dam_break_88k",
     "double_dam_break_128k",
     "obstacle_298k",
+    "dam_break_1m",
 ];
 
 /// Particle radius of the built-in scenes (m).
@@ -46,6 +47,13 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             "A 43x57x36 block of water (88,236 particles) collapses in a 7.2 x 4.3 x 1.85 m box: the 30k setup scaled by 1.43 with the same particle radius. Walls r/4 outside the nominal box.",
             [43, 57, 36],
             [7.20625, 4.30625, 1.85625],
+            2.0,
+        )),
+        "dam_break_1m" => Some(dam_break(
+            name,
+            "A 97x129x80 block of water (1,001,040 particles) collapses in a 16.1 x 9.65 x 4.05 m box: the 30k setup scaled by 3.22 with the same particle radius. Walls r/4 outside the nominal box.",
+            [97, 129, 80],
+            [16.10625, 9.65625, 4.05625],
             2.0,
         )),
         "double_dam_break_128k" => Some(Scene {
@@ -260,6 +268,7 @@ mod tests {
             ("dam_break_88k", 88_236),
             ("double_dam_break_128k", 128_000),
             ("obstacle_298k", 297_754),
+            ("dam_break_1m", 1_001_040),
         ] {
             assert_eq!(Scene::builtin(name).unwrap().particle_count(), count);
         }

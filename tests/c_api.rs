@@ -459,6 +459,7 @@ fn c_tests_are_clean_under_valgrind() {
         ("tests/c/bodies.c", &["2"][..]),
         ("tests/c/emitters.c", &[][..]),
         ("tests/c/scene.c", &[][..]),
+        ("tests/c/placement.c", &[][..]),
     ] {
         let program = build(source, Link::Static);
         let output = Command::new("valgrind")

@@ -46,10 +46,30 @@ pub(super) enum Settling {
     /// Also projects every compression near the new particles away on their positions, over
     /// the whole world, and evaluates the densities frames report before the first step.
     Block,
-    /// An emitter's layers, inserted at the start of a step into fluid that is moving: see
-    /// [`World::settle_emitted`].
-    Emitted,
 }
+
+/// How far [`World::placement_projection`] goes.
+#[derive(Clone, Copy, Debug)]
+struct Projection {
+    /// Most passes.
+    passes: usize,
+    /// Whether a particle that cannot move counts only the compression the movable ones add
+    /// (fluid moving through a step reads compressions of its own, which emitted particles
+    /// are not to chase).
+    added_only: bool,
+}
+
+/// The projection of fluid added between steps.
+const BLOCK: Projection = Projection {
+    passes: PLACEMENT_PASSES,
+    added_only: false,
+};
+
+/// The projection of an emitter's new layers.
+const EMITTED: Projection = Projection {
+    passes: EMISSION_PASSES,
+    added_only: true,
+};
 
 /// The solids a new fluid particle must not start inside: the container boxes (their
 /// outside) and the closed meshes of obstacles and bodies where they stand now.
@@ -302,7 +322,7 @@ impl World {
         let settled = self.pool.install(|| {
             let snapshot = self.snapshot_with(h, true)?;
             let positions = self.fluid.positions.clone();
-            self.placement_projection(snapshot, positions, movable, &clear, Settling::Block)
+            self.placement_projection(snapshot, positions, movable, &clear, BLOCK)
                 .expect("memory for the placement's neighbour search")
         });
         if let Some(settled) = settled {
@@ -394,8 +414,7 @@ impl World {
         let clear = |positions: &mut [Vec3]| {
             clear_of_solids(positions, &local_holders, &movable, solids, r)
         };
-        let settled =
-            self.placement_projection(snapshot, positions, &movable, &clear, Settling::Emitted)?;
+        let settled = self.placement_projection(snapshot, positions, &movable, &clear, EMITTED)?;
         Ok(settled.map(|settled| (taken, settled)))
     }
 
@@ -406,25 +425,18 @@ impl World {
 
     /// `positions` (m, indexed as the snapshot's `fluid_order` indexes) after the passes of
     /// the placement projection of the particles marked in `movable` (indexed alike) over
-    /// `snapshot`, or `None` where nothing was compressed. With [`Settling::Emitted`] the
-    /// passes are fewer and the particles that cannot move count only the compression the
-    /// movable ones add. Runs on the caller's pool; errors when memory cannot be had.
+    /// `snapshot`, or `None` where nothing was compressed, as far as `projection` says.
+    /// Runs on the caller's pool; errors when memory cannot be had.
     fn placement_projection(
         &self,
         mut snapshot: Snapshot,
         mut positions: Vec<Vec3>,
         movable: &[bool],
         clear: &(dyn Fn(&mut [Vec3]) + Sync),
-        settling: Settling,
+        Projection { passes, added_only }: Projection,
     ) -> Result<Option<Vec<Vec3>>, TryReserveError> {
         let h = self.params.support_radius();
         let step = PLACEMENT_STEP * self.params.particle_radius;
-        // Fluid moving through a step reads compressions of its own, which emitted
-        // particles are not to chase: they answer only for what they add.
-        let (passes, added_only) = match settling {
-            Settling::Emitted => (EMISSION_PASSES, true),
-            _ => (PLACEMENT_PASSES, false),
-        };
         // What the lattice itself reads is the mass factor's choice, not placement's to undo.
         let tolerance = PLACEMENT_TOLERANCE + self.lattice_compression();
         let rest = self.constraint.rest_density;

@@ -63,13 +63,6 @@ fn try_collect<T>(items: impl Iterator<Item = T> + Clone) -> Result<Vec<T>, TryR
     Ok(out)
 }
 
-/// `points` (m) held by component.
-fn points_by_component(points: &[Vec3]) -> PointsByComponent {
-    let mut out = PointsByComponent::default();
-    out.fill(points).expect(OUT_OF_MEMORY);
-    out
-}
-
 impl World {
     /// The fluid and boundary particles sorted into a fresh grid, or `None` when there are
     /// none. Runs on the caller's thread pool (call it inside the world's). Before the first
@@ -113,24 +106,7 @@ impl World {
             UniformGrid::covering(bounds.min - pad, bounds.max + pad, h).expect(OUT_OF_MEMORY);
         let mut psi = match known.filter(|_| !boundary.dirty) {
             Some(psi) => psi,
-            None => {
-                // Akinci volumes over the static particles (docs/method.md §2.6).
-                let mut bx = PointsByComponent::default();
-                let mut order = Vec::new();
-                let mut boundary_table = CellTable::default();
-                grid.sort(&points, &mut order, &mut boundary_table)
-                    .expect(OUT_OF_MEMORY);
-                bx.try_permuted_from(&points_by_component(&points), &order)
-                    .expect(OUT_OF_MEMORY);
-                let kernel = &self.constraint.kernel;
-                let volumes =
-                    akinci_volumes(&grid, &boundary_table, &bx, kernel).expect(OUT_OF_MEMORY);
-                let mut psi = vec![0.0; points.len()];
-                for (&k, v) in order.iter().zip(volumes) {
-                    psi[k as usize] = v * self.params.rest_density;
-                }
-                psi
-            }
+            None => self.static_masses(&grid, &points).expect(OUT_OF_MEMORY),
         };
         for (p, own) in self.moving_body_particles(bodies) {
             points.push(p);
@@ -187,20 +163,9 @@ impl World {
                 try_collect(statics(reach).map(|k| boundary.psi[k]))?,
             )
         } else {
-            // Akinci volumes (docs/method.md §2.6) over the static particles near the region.
+            // The static particles near the region, with their neighbours.
             let near = try_collect(statics(wide).map(|k| boundary.positions.at(k)))?;
-            let mut table = CellTable::default();
-            let mut order = Vec::new();
-            grid.sort(&near, &mut order, &mut table)?;
-            let mut bx = PointsByComponent::default();
-            let mut by_component = PointsByComponent::default();
-            by_component.fill(&near)?;
-            bx.try_permuted_from(&by_component, &order)?;
-            let volumes = akinci_volumes(&grid, &table, &bx, &self.constraint.kernel)?;
-            let mut psi = try_collect(std::iter::repeat_n(0.0, near.len()))?;
-            for (&k, v) in order.iter().zip(volumes) {
-                psi[k as usize] = v * self.params.rest_density;
-            }
+            let psi = self.static_masses(&grid, &near)?;
             let kept = |k: &usize| reach.contains(&near[*k], 0.0);
             let points = try_collect((0..near.len()).filter(kept).map(|k| near[k]))?;
             (
@@ -217,6 +182,28 @@ impl World {
             }
         }
         Ok(Some((self.sorted(grid, &fluid, &points, &psi)?, taken)))
+    }
+
+    /// The Akinci masses ψ_b = ρ0·V_b (kg) of the static boundary particles at `points` (m),
+    /// from their neighbours among them (docs/method.md §2.6), sorted into `grid`.
+    fn static_masses(
+        &self,
+        grid: &UniformGrid,
+        points: &[Vec3],
+    ) -> Result<Vec<f64>, TryReserveError> {
+        let mut table = CellTable::default();
+        let mut order = Vec::new();
+        grid.sort(points, &mut order, &mut table)?;
+        let mut by_component = PointsByComponent::default();
+        by_component.fill(points)?;
+        let mut bx = PointsByComponent::default();
+        bx.try_permuted_from(&by_component, &order)?;
+        let volumes = akinci_volumes(grid, &table, &bx, &self.constraint.kernel)?;
+        let mut psi = try_collect(std::iter::repeat_n(0.0, points.len()))?;
+        for (&k, v) in order.iter().zip(volumes) {
+            psi[k as usize] = v * self.params.rest_density;
+        }
+        Ok(psi)
     }
 
     /// The fluid at `fluid` and the boundary at `points` with masses `psi` (kg) sorted into

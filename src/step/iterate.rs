@@ -1,6 +1,7 @@
 //! The outer local/global iteration of a step (docs/method.md §1.3, §3, §4): the system
 //! matrix of formulation F1 frozen for the step, then local projections and global solves
-//! from X^(0) = X^(−1) = s or its warm start (§4.1), with Chebyshev's extrapolation, until
+//! from X^(0) = X^(−1) = s or its warm start (§4.1, withdrawn where the fluid does not need
+//! it), with Chebyshev's extrapolation, until
 //! the fluid's average compression is at most η (once no particle moves farther than 10τ)
 //! or no particle moved farther than τ; a step whose extrapolation reaches K_max starts
 //! over from s without it.
@@ -95,9 +96,11 @@ pub(super) fn iterate(
 
     // The fluid holds one support per particle once a step with the warm start recorded
     // them (none before: the iteration then starts from s).
+    b.start_offsets.clear();
     if warm && fluid.supports.len() == fluid.len() {
         let (share, reach) = (params.warm_start, params.particle_radius);
-        warm_start::start(&mut b.current, &fluid.supports, &b.order, share, dt, reach);
+        let (x, offsets) = (&mut b.current, &mut b.start_offsets);
+        warm_start::start(x, offsets, &fluid.supports, &b.order, share, dt, reach)?;
     }
     b.previous.clone_from(&b.current);
     constraint.weights(&b.fluid_lists, &mut b.weights);
@@ -138,6 +141,7 @@ pub(super) fn iterate(
                 .enumerate()
                 .for_each(|(j, x)| *x = predicted.at(j));
             b.previous.clone_from(&b.current);
+            b.start_offsets.clear();
             if couple {
                 b.coupling.restart();
             }
@@ -230,6 +234,11 @@ pub(super) fn iterate(
         std::mem::swap(&mut b.previous, &mut b.current);
         if !single_sweep {
             std::mem::swap(&mut b.current, &mut b.next);
+        }
+        if !b.start_offsets.is_empty() {
+            let (current, previous) = (&mut b.current, &mut b.previous);
+            let (offsets, rest) = (&mut b.start_offsets, constraint.rest_density);
+            warm_start::release(current, previous, offsets, &b.projections, rest);
         }
         outer += 1;
         k += 1;

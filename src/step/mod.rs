@@ -65,6 +65,9 @@ pub(crate) struct StepBuffers {
     loads: Vec<Load>,
     /// What the step changed before it could still fail.
     pub(crate) undo: Undo,
+    /// What remains of every slot's warm start X^(0) − s (m), withdrawn as the iteration finds
+    /// the fluid under-dense; empty in steps that start from s (docs/method.md §4.1).
+    start_offsets: Vec<Vec3>,
     /// The stencil sizes (fluid, boundary members) that every thread's buffers of the local
     /// step have room for ([`crate::constraint::reserve_scratch`]).
     scratch_room: (usize, usize),

@@ -146,9 +146,11 @@ mod step {
 
     /// The warm start (docs/method.md §4.1) spares a tall collapsing column some of the
     /// outer iterations that lift it off the floor anew in every step, the more the larger
-    /// its share, and what it saves is not bought with the density error or the energy:
-    /// every step still ends at most η compressed (or by τ), and the energy never rises
-    /// above its start.
+    /// its share, and what it saves is not bought with the density error, the energy or the
+    /// flow: every step still ends at most η compressed (or by τ), the energy never rises
+    /// above its start, and the surge's mean horizontal speed at 0.5 s stays within 4 % of
+    /// its speed without the start (1.7 % and 3.2 % short at f = 0.45 and 0.8). Without the
+    /// withdrawal of the start where the fluid turns under-dense it fell short by 7 and 15 %.
     #[test]
     fn the_warm_start_spares_the_column_its_lift() {
         let run = |share: f64| {
@@ -171,13 +173,22 @@ mod step {
                 highest <= initial,
                 "f {share}: {highest} J from {initial} J"
             );
-            outer
+            let v = world.velocities();
+            let surge = v.iter().map(|v| v.x).sum::<f64>() / v.len() as f64;
+            (outer, surge)
         };
         let (cold, warm, warmer) = (run(0.0), run(0.45), run(0.8));
         assert!(
-            (warm as f64) < 0.9 * cold as f64 && warmer < warm,
-            "{cold}, {warm} and {warmer} outer iterations at f = 0, 0.45 and 0.8"
+            (warm.0 as f64) < 0.97 * cold.0 as f64 && warmer.0 < warm.0,
+            "{cold:?}, {warm:?} and {warmer:?} (outer iterations, surge m/s) at f = 0, 0.45 and 0.8"
         );
+        for (share, (_, surge)) in [(0.45, warm), (0.8, warmer)] {
+            assert!(
+                (surge / cold.1 - 1.0).abs() < 0.04,
+                "surge {surge} m/s at f = {share} against {} m/s without the start",
+                cold.1
+            );
+        }
     }
 
     /// Steps the small dam break twice for 25 steps, once as is and once changed by

@@ -267,8 +267,9 @@ typedef struct PfParams {
      * Share f of the last step's support a step starts from, in [0, 1) (0: every step
      * starts from its prediction s): particles that active constraints moved in the last
      * step start the outer iteration from s + f·Δt²·a, a being that step's displacement from
-     * its prediction per Δt² (m/s², at most 2|g|). Not used in worlds with bodies; 0 in the
-     * calm settings. Default 0.
+     * its prediction per Δt² (m/s², at most 2|g|); the start of particles the iteration finds
+     * under-dense is withdrawn. Not used in worlds with bodies; 0 in the calm settings.
+     * Default 0.
      */
     double warm_start;
     /**

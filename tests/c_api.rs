@@ -16,6 +16,7 @@ use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering::Relaxed};
 
 #[path = "support/c_bodies.rs"]
 mod c_bodies;
@@ -448,33 +449,51 @@ fn c_tests_are_clean_under_valgrind() {
     let obj_dir = out_dir().join("obj-files-valgrind");
     std::fs::create_dir_all(&obj_dir).unwrap();
     let obj_dir = obj_dir.to_string_lossy().into_owned();
+    let obj_args = [obj_dir.as_str()];
     // Not tests/c/oom.c: it limits the address space (RLIMIT_AS) relative to the process's
     // usage, which valgrind's own mappings and replaced allocator make meaningless.
-    for (source, args) in [
+    // placement.c first: it takes longer under valgrind than all the others together.
+    let runs: Vec<(&str, PathBuf, &[&str])> = [
+        ("tests/c/placement.c", &[][..]),
         ("tests/c/basic.c", &["2"][..]),
         ("tests/c/misuse.c", &[][..]),
         ("tests/c/mesh.c", &["0.01"][..]),
-        ("tests/c/obj.c", &[obj_dir.as_str()][..]),
+        ("tests/c/obj.c", &obj_args[..]),
         ("tests/c/parallel.c", &["2"][..]),
         ("tests/c/bodies.c", &["2"][..]),
         ("tests/c/emitters.c", &[][..]),
         ("tests/c/scene.c", &[][..]),
-        ("tests/c/placement.c", &[][..]),
-    ] {
-        let program = build(source, Link::Static);
-        let output = Command::new("valgrind")
-            .args(["--error-exitcode=99", "--leak-check=full", "--quiet"])
-            .arg(format!("--suppressions={}", suppressions.display()))
-            .arg(&program)
-            .args(args)
-            .output()
-            .expect("valgrind runs");
-        assert!(
-            output.status.success(),
-            "valgrind found errors or leaks in {source}: {}",
-            describe(&output)
-        );
-    }
+    ]
+    .into_iter()
+    .map(|(source, args)| (source, build(source, Link::Static), args))
+    .collect();
+    // Valgrind runs a program on one core, so the programs run side by side, one per core.
+    let next = AtomicUsize::new(0);
+    let failures = Mutex::new(Vec::new());
+    let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
+    std::thread::scope(|scope| {
+        for _ in 0..workers.min(runs.len()) {
+            scope.spawn(|| {
+                while let Some((source, program, args)) = runs.get(next.fetch_add(1, Relaxed)) {
+                    let output = Command::new("valgrind")
+                        .args(["--error-exitcode=99", "--leak-check=full", "--quiet"])
+                        .arg(format!("--suppressions={}", suppressions.display()))
+                        .arg(program)
+                        .args(*args)
+                        .output()
+                        .expect("valgrind runs");
+                    if !output.status.success() {
+                        failures.lock().unwrap().push(format!(
+                            "valgrind found errors or leaks in {source}: {}",
+                            describe(&output)
+                        ));
+                    }
+                }
+            });
+        }
+    });
+    let failures = failures.into_inner().unwrap();
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]

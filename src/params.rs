@@ -276,10 +276,10 @@ pub fn check_step(field: &str, dt: f64) -> Result<(), crate::Error> {
 /// density rule holds in every step it ends (docs/method.md §4).
 pub const DEFAULT_DENSITY_TOLERANCE: f64 = 3e-4;
 
-/// The default [`Params::warm_start`]: off. A start saves outer iterations (a quarter on
-/// `dam_break_30k`, 44 % on `dam_break_88k`) but still changes some flows: it throws particles
-/// off the top of a deep column in the step that first holds it up, and slows a narrow
-/// column's surge by a few per cent (docs/method.md §4.1).
+/// The default [`Params::warm_start`]: off. A start saves outer iterations (at f = 0.99, a
+/// quarter on `dam_break_30k` and 44 % on `dam_break_88k`) but still changes some flows: it
+/// throws particles off the top of a deep column in the step that first holds it up, and
+/// slows a narrow column's surge by a few per cent (docs/method.md §4.1).
 pub const DEFAULT_WARM_START: f64 = 0.0;
 /// Default CFL factor λ, chosen by measurement on `dam_break_30k` (docs/method.md §8): at
 /// 1.25 a particle moves at most r per step, and the outer iterations per simulated second

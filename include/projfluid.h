@@ -32,7 +32,7 @@
  * Version of the binary interface this header describes; compare it with pf_abi_version()
  * at run time to detect a header/library mismatch.
  */
-#define PF_ABI_VERSION 2
+#define PF_ABI_VERSION 3
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -272,6 +272,13 @@ typedef struct PfParams {
      * Default 0.
      */
     double warm_start;
+    /**
+     * 1: correct the start of every step's outer iteration on a coarse lattice, moving the
+     * whole fluid at once by the displacement that removes its compression on cells of two
+     * support radii, so that deep water needs no more outer iterations than shallow; 0: off.
+     * Not used in worlds with bodies. Default 1.
+     */
+    uint32_t coarse_correction;
     /**
      * Smallest number of outer iterations per step (≥ 1). Default 1.
      */

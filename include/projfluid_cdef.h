@@ -22,7 +22,7 @@
  * Version of the binary interface these declarations describe; compare it with
  * pf_abi_version() at run time to detect a declarations/library mismatch.
  */
-enum { PF_ABI_VERSION = 2 };
+enum { PF_ABI_VERSION = 3 };
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -262,6 +262,13 @@ typedef struct PfParams {
      * Default 0.
      */
     double warm_start;
+    /**
+     * 1: correct the start of every step's outer iteration on a coarse lattice, moving the
+     * whole fluid at once by the displacement that removes its compression on cells of two
+     * support radii, so that deep water needs no more outer iterations than shallow; 0: off.
+     * Not used in worlds with bodies. Default 1.
+     */
+    uint32_t coarse_correction;
     /**
      * Smallest number of outer iterations per step (≥ 1). Default 1.
      */

@@ -37,6 +37,7 @@ class PfParams(ctypes.Structure):
         ("density_tolerance", c_double),
         ("displacement_tolerance", c_double),
         ("warm_start", c_double),
+        ("coarse_correction", c_uint32),
         ("min_outer_iterations", c_uint32),
         ("max_outer_iterations", c_uint32),
         ("cfl_factor", c_double),

@@ -21,6 +21,9 @@ pub struct RunSummary {
     pub eta: f64,
     /// Outer stopping threshold τ (m).
     pub tau: f64,
+    /// The coarse correction of each step's outer iteration was on (it is not used in worlds
+    /// with bodies).
+    pub coarse_correction: bool,
     /// Worker threads.
     pub threads: usize,
     /// Fluid particles.
@@ -157,6 +160,7 @@ impl RunAccumulator {
             rho_auto: p.chebyshev.auto_rho,
             eta: p.density_tolerance,
             tau: p.displacement_tolerance,
+            coarse_correction: p.coarse_correction,
             threads: world.thread_count(),
             particles: world.fluid_count(),
             boundary_particles: world.boundary_count(),

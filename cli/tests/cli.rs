@@ -178,6 +178,7 @@ fn short_run_writes_stats_and_frames() {
         "solver",
         "rho",
         "tau",
+        "coarse_correction",
         "threads",
         "particles",
         "boundary_particles",
@@ -200,6 +201,7 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(json["particles"], 3840);
     assert_eq!(json["steps"], 3);
     assert_eq!(json["threads"], 2);
+    assert_eq!(json["coarse_correction"], true);
     assert_eq!(json["nan"], 0);
 
     let mut names: Vec<String> = std::fs::read_dir(&frames)
@@ -560,6 +562,52 @@ fn scenes_lists_builtins_with_particle_counts() {
         stdout.contains("dam_break_30k") && stdout.contains("30000"),
         "{stdout}"
     );
+}
+
+/// `--coarse-correction` takes `on` or `off` and replaces the scene's
+/// `solver.coarse_correction`, which the summary and the stats report; any other value is
+/// refused naming the option.
+#[test]
+fn coarse_correction_is_switched_on_or_off() {
+    let run = |value: &str, stats: &Path| {
+        projfluid(&[
+            "run",
+            "dam_break_small",
+            "--steps",
+            "2",
+            "--coarse-correction",
+            value,
+            "--stats",
+            stats.to_str().unwrap(),
+        ])
+    };
+    let dir = temp_dir("coarse-correction");
+    let stats = dir.join("stats.json");
+    assert_bad_input(
+        &run("maybe", &stats),
+        &["--coarse-correction", "maybe", "on", "off"],
+    );
+    assert!(!stats.exists(), "a refused run wrote {}", stats.display());
+    for (value, on) in [("off", false), ("on", true)] {
+        let out = run(value, &stats);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "--coarse-correction {value}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            stdout.contains(&format!("coarse correction {value}")),
+            "{stdout}"
+        );
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert_eq!(json["coarse_correction"], on, "{json}");
+        assert_eq!(json["steps"], 2);
+        assert_eq!(json["nan"], 0);
+    }
+    std::fs::remove_dir_all(&dir).unwrap();
 }
 
 /// `--rho auto` estimates ρ_c online: the summary and the stats say so and report the mean

@@ -140,6 +140,22 @@ def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World)
     assert calm.particle_radius == defaults.particle_radius
 
 
+def test_the_coarse_correction_is_a_switch_a_world_reports_back() -> None:
+    assert projfluid.Params().coarse_correction is True
+    assert projfluid.Params().calm().coarse_correction is True
+    off = small_params(coarse_correction=False)
+    assert off.coarse_correction is False and off.to_c().coarse_correction == 0
+    assert small_params(coarse_correction=1).to_c().coarse_correction == 1
+    assert projfluid.Params.from_c(off.to_c()) == off
+    with projfluid.World(off) as world:
+        assert world.params.coarse_correction is False
+        assert world.params == off
+        world.add_container_box((0, 0, 0), (0.5, 0.4, 0.3))
+        world.add_fluid_box((0.03, 0.03, 0.03), (6, 7, 5))
+        stats = world.advance(0.02)
+        assert stats.nan_count == 0 and stats.escaped_count == 0
+
+
 def test_steps_report_their_statistics(world: projfluid.World) -> None:
     assert world.last_step.step_count == 0
     first = world.step(0.002)

@@ -102,6 +102,11 @@ pub struct PfParams {
     /// under-dense is withdrawn. Not used in worlds with bodies; 0 in the calm settings.
     /// Default 0.
     pub warm_start: f64,
+    /// 1: correct the start of every step's outer iteration on a coarse lattice, moving the
+    /// whole fluid at once by the displacement that removes its compression on cells of two
+    /// support radii, so that deep water needs no more outer iterations than shallow; 0: off.
+    /// Not used in worlds with bodies. Default 1.
+    pub coarse_correction: u32,
     /// Smallest number of outer iterations per step (≥ 1). Default 1.
     pub min_outer_iterations: u32,
     /// Largest number of outer iterations per step (≤ 100000). Default 100. Where Chebyshev's
@@ -156,6 +161,7 @@ impl From<&Params> for PfParams {
             density_tolerance: p.density_tolerance,
             displacement_tolerance: p.displacement_tolerance,
             warm_start: p.warm_start,
+            coarse_correction: u32::from(p.coarse_correction),
             min_outer_iterations: small(p.min_outer_iterations),
             max_outer_iterations: small(p.max_outer_iterations),
             cfl_factor: p.cfl_factor,
@@ -227,6 +233,15 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
             )));
         }
     };
+    let coarse_correction = match field!(coarse_correction) {
+        0 => false,
+        1 => true,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->coarse_correction must be 0 or 1, got {n}"
+            )));
+        }
+    };
     let count = |n: u32| n as usize;
     let params = Params {
         particle_radius: field!(particle_radius),
@@ -245,6 +260,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         density_tolerance: field!(density_tolerance),
         displacement_tolerance: field!(displacement_tolerance),
         warm_start: field!(warm_start),
+        coarse_correction,
         min_outer_iterations: count(field!(min_outer_iterations)),
         max_outer_iterations: count(field!(max_outer_iterations)),
         projection_weight,

@@ -70,6 +70,7 @@ struct SolverFile {
     eta: Option<f64>,
     tau: Option<f64>,
     warm_start: Option<f64>,
+    coarse_correction: Option<bool>,
     max_iterations: Option<usize>,
     min_iterations: Option<usize>,
     projection_weight: Option<ProjectionWeight>,
@@ -228,6 +229,7 @@ impl SceneFile {
         set(&mut p.density_tolerance, s.eta);
         set(&mut p.displacement_tolerance, s.tau);
         set(&mut p.warm_start, s.warm_start);
+        p.coarse_correction = s.coarse_correction.unwrap_or(p.coarse_correction);
         p.max_outer_iterations = s.max_iterations.unwrap_or(p.max_outer_iterations);
         p.min_outer_iterations = s.min_iterations.unwrap_or(p.min_outer_iterations);
         p.projection_weight = s.projection_weight.unwrap_or(p.projection_weight);
@@ -320,6 +322,7 @@ impl SceneFile {
                 eta: Some(p.density_tolerance),
                 tau: Some(p.displacement_tolerance),
                 warm_start: Some(p.warm_start),
+                coarse_correction: Some(p.coarse_correction),
                 max_iterations: Some(p.max_outer_iterations),
                 min_iterations: Some(p.min_outer_iterations),
                 projection_weight: Some(p.projection_weight),

@@ -149,7 +149,9 @@ fn to_json_key(error: Error) -> Error {
         return error;
     };
     let key = match field.as_str() {
-        "rho" | "delay" | "gamma" | "warm_start" => format!("solver.{field}"),
+        "rho" | "delay" | "gamma" | "warm_start" | "coarse_correction" => {
+            format!("solver.{field}")
+        }
         "displacement_tolerance" => "solver.tau".to_string(),
         "density_tolerance" => "solver.eta".to_string(),
         "min_outer_iterations" => "solver.min_iterations".to_string(),

@@ -50,6 +50,7 @@ static void bad_params(PfParams p, const char *field) {
     CHECK(memcmp(&calm.chebyshev_rho, &p.chebyshev_rho, sizeof(double)) == 0);
     CHECK(memcmp(&calm.chebyshev_gamma, &p.chebyshev_gamma, sizeof(double)) == 0);
     CHECK(calm.chebyshev_auto_rho == p.chebyshev_auto_rho);
+    CHECK(calm.coarse_correction == p.coarse_correction);
     rejected += 3;
 }
 
@@ -110,6 +111,12 @@ int main(void) {
     p = params;
     p.projection_weight = (PfProjectionWeight)-1;
     bad_params(p, "projection_weight");
+    p = params;
+    p.chebyshev_auto_rho = 2;
+    bad_params(p, "chebyshev_auto_rho");
+    p = params;
+    p.coarse_correction = 2;
+    bad_params(p, "coarse_correction");
 
     /* --- NULL pointers outside a world. --- */
     PfWorld *w = NULL;

@@ -1,6 +1,6 @@
 """The C library: finding and loading it, mirrors of its structs, its functions' signatures.
 
-Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 2); the rest of the
+Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 3); the rest of the
 package calls the C API only through :data:`lib`. ctypes releases the GIL during every
 foreign call, so long calls such as ``pf_world_advance`` let other Python threads run.
 """
@@ -28,7 +28,7 @@ from pathlib import Path
 from typing import Any
 
 #: The binary interface these declarations were written for (``PF_ABI_VERSION``).
-ABI_VERSION = 2
+ABI_VERSION = 3
 
 
 def library_file_name() -> str:
@@ -68,6 +68,7 @@ class PfParams(ctypes.Structure):
         ("density_tolerance", c_double),
         ("displacement_tolerance", c_double),
         ("warm_start", c_double),
+        ("coarse_correction", c_uint32),
         ("min_outer_iterations", c_uint32),
         ("max_outer_iterations", c_uint32),
         ("cfl_factor", c_double),

@@ -126,6 +126,11 @@ class Params:
     active constraints moved in the last step start the outer iteration from s + f·Δt²·a,
     a being that step's displacement from its prediction per Δt² (0 starts every step from
     its prediction s, the default). Not used in worlds with bodies; 0 in the calm settings."""
+    coarse_correction: bool = bool(_C_DEFAULTS.coarse_correction)
+    """Correct the start of every step's outer iteration on a coarse lattice (True, the
+    default): the whole fluid moves at once by the displacement that removes its compression
+    on cells of two support radii, so that deep water needs no more outer iterations than
+    shallow. Not used in worlds with bodies."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations
     """Smallest number of outer iterations per step (≥ 1)."""
     max_outer_iterations: int = _C_DEFAULTS.max_outer_iterations
@@ -176,7 +181,8 @@ class Params:
         return cls(**{field.name: getattr(c, field.name) for field in dataclasses.fields(cls)})
 
 
-_INTEGERS = (*_ENUMS, *_UNSIGNED, "chebyshev_auto_rho")
+_SWITCHES = ("chebyshev_auto_rho", "coarse_correction")
+_INTEGERS = (*_ENUMS, *_UNSIGNED, *_SWITCHES)
 
 
 def _normalized(name: str, value: Any) -> Any:
@@ -186,7 +192,7 @@ def _normalized(name: str, value: Any) -> Any:
         return _to_enum(_ENUMS[name], value, name)
     if name == "gravity":
         return _vector3(value, name)
-    if name == "chebyshev_auto_rho":
+    if name in _SWITCHES:
         return bool(value)
     if name in _UNSIGNED:
         return _unsigned32(value, name)

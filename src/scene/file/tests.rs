@@ -47,8 +47,8 @@ fn every_key_is_read() {
             "container": [{"min": [0, 0, 0], "max": [1, 1, 1], "walls": "particles", "layers": 2}],
             "fluid_blocks": [{"start": [0.1, 0.1, 0.1], "count": [2, 2, 2], "velocity": [0, 1, 0]}],
             "solver": {"kind": "jacobi", "rho": 0.8, "delay": 2, "omega2": "paper", "gamma": 0.9,
-                       "tau": 1e-6, "warm_start": 0.3, "max_iterations": 50, "min_iterations": 2,
-                       "projection_weight": "unit"},
+                       "tau": 1e-6, "warm_start": 0.3, "coarse_correction": false,
+                       "max_iterations": 50, "min_iterations": 2, "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
             "viscosity": 0.02, "threads": 2, "duration": 3,
             "output": {"dir": "frames", "every": 5, "fps": 25}
@@ -72,6 +72,7 @@ fn every_key_is_read() {
     assert_eq!(p.chebyshev.gamma, 0.9);
     assert_eq!(p.displacement_tolerance, 1e-6);
     assert_eq!(p.warm_start, 0.3);
+    assert!(!p.coarse_correction);
     assert_eq!((p.min_outer_iterations, p.max_outer_iterations), (2, 50));
     assert_eq!(p.projection_weight, crate::ProjectionWeight::Unit);
     assert_eq!(
@@ -103,6 +104,7 @@ fn round_trip_through_json() {
     custom.params.solver = crate::SolverKind::Jacobi1;
     custom.params.projection_weight = crate::ProjectionWeight::Unit;
     custom.params.chebyshev.omega2_rule = crate::Omega2Rule::Paper;
+    custom.params.coarse_correction = false;
     custom.output.dir = Some(PathBuf::from("out [1]/frames"));
     custom.description = "quotes \" and [brackets]".to_string();
     scenes.push(custom);
@@ -193,6 +195,34 @@ fn rho_auto_is_read_written_and_checked() {
     assert_names(
         &message(Scene::from_json(&bad)),
         &["solver.rho", "fast", "\"auto\""],
+    );
+}
+
+/// `solver.coarse_correction` is on unless a scene turns it off, and a scene written out
+/// keeps the setting.
+#[test]
+fn coarse_correction_is_read_and_written() {
+    assert!(Scene::from_json(GOOD).unwrap().params.coarse_correction);
+    let off = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"solver\": {\"coarse_correction\": false}, \"fluid_blocks\"",
+        1,
+    );
+    let scene = Scene::from_json(&off).unwrap();
+    assert!(!scene.params.coarse_correction);
+    let json = scene.to_json();
+    assert!(json.contains("\"coarse_correction\": false"), "{json}");
+    let again = Scene::from_json(&json).unwrap();
+    assert!(!again.params.coarse_correction);
+    assert_eq!(again, scene);
+    let bad = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"solver\": {\"coarse_correction\": 1}, \"fluid_blocks\"",
+        1,
+    );
+    assert_names(
+        &message(Scene::from_json(&bad)),
+        &["solver.coarse_correction"],
     );
 }
 

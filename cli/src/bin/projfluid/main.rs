@@ -78,6 +78,12 @@ pub(crate) fn solver_parser() -> impl TypedValueParser<Value = SolverKind> {
     })
 }
 
+/// An `on|off` switch such as `--coarse-correction`: `on` is true, shown as the possible
+/// values.
+pub(crate) fn on_off_parser() -> impl TypedValueParser<Value = bool> {
+    PossibleValuesParser::new(["on", "off"]).map(|value| value == "on")
+}
+
 /// A `--rho` value: a fixed ρ_c or `auto` (estimated online).
 #[derive(Clone, Copy, Debug)]
 pub(crate) enum RhoArg {

@@ -63,6 +63,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         eta: None,
         tau: args.tau,
         warm_start: None,
+        coarse_correction: None,
         threads: args.threads,
     };
     options.apply_checked(&mut scene)?;

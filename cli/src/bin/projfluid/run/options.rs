@@ -1,7 +1,7 @@
 //! Solver options every subcommand that runs scenes accepts, and validation that names the
 //! option behind a bad value.
 
-use crate::{Failure, RhoArg, rho_parser};
+use crate::{Failure, RhoArg, on_off_parser, rho_parser};
 use clap::Args;
 use projfluid::Error;
 use projfluid::scene::Scene;
@@ -24,6 +24,11 @@ pub(crate) struct ParamOptions {
     /// step from its inertial prediction).
     #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
     pub(crate) warm_start: Option<f64>,
+    /// Correct the start of every step's outer iteration on a coarse lattice, moving the
+    /// whole fluid at once to remove its compression, so that deep water needs no more outer
+    /// iterations than shallow (on by default; not used in worlds with bodies).
+    #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
+    pub(crate) coarse_correction: Option<bool>,
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N")]
     pub(crate) threads: Option<usize>,
@@ -45,13 +50,16 @@ impl ParamOptions {
         if let Some(share) = self.warm_start {
             p.warm_start = share;
         }
+        if let Some(on) = self.coarse_correction {
+            p.coarse_correction = on;
+        }
         if let Some(threads) = self.threads {
             p.threads = threads;
         }
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 5] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 6] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
             ("solver.eta", "--eta", self.eta.is_some()),
@@ -60,6 +68,11 @@ impl ParamOptions {
                 "solver.warm_start",
                 "--warm-start",
                 self.warm_start.is_some(),
+            ),
+            (
+                "solver.coarse_correction",
+                "--coarse-correction",
+                self.coarse_correction.is_some(),
             ),
             ("threads", "--threads", self.threads.is_some()),
         ]

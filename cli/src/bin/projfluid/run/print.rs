@@ -13,8 +13,9 @@ pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
             } else {
                 format!("rho {}", s.rho)
             };
+            let coarse = if s.coarse_correction { "on" } else { "off" };
             format!(
-                "{} ({rho}; eta {:.3} %, tau {:.3e} m)",
+                "{} ({rho}; eta {:.3} %, tau {:.3e} m; coarse correction {coarse})",
                 s.solver,
                 s.eta * 100.0,
                 s.tau

@@ -232,6 +232,11 @@ pub struct Params {
     /// start of particles it finds under-dense (docs/method.md §4.1). Not used in worlds with
     /// bodies nor in the calm settings.
     pub warm_start: f64,
+    /// Correct the start of every step's outer iteration on a coarse lattice (default on):
+    /// the whole fluid moves at once by the displacement that removes its compression on
+    /// cells of two support radii, so that deep water needs no more outer iterations than
+    /// shallow (docs/method.md §3.8). Not used in worlds with bodies.
+    pub coarse_correction: bool,
     /// Smallest number of outer iterations per step (≥ 1).
     pub min_outer_iterations: usize,
     /// Largest number of outer iterations per step.
@@ -340,6 +345,7 @@ impl Params {
             density_tolerance: DEFAULT_DENSITY_TOLERANCE,
             displacement_tolerance: DEFAULT_TOLERANCE_PER_RADIUS * r,
             warm_start: DEFAULT_WARM_START,
+            coarse_correction: true,
             min_outer_iterations: 1,
             max_outer_iterations: 100,
             projection_weight: ProjectionWeight::NeighborCount,

@@ -7,7 +7,7 @@
 //! over from s without it.
 
 use super::search::Prediction;
-use super::{StepBuffers, couple, warm_start};
+use super::{StepBuffers, coarse, couple, warm_start};
 use crate::boundary::Boundary;
 use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection};
 use crate::fluid::Fluid;
@@ -42,6 +42,8 @@ pub(super) struct Iteration<'a> {
     pub couple: bool,
     /// Start from the warm start rather than from s (docs/method.md §4.1).
     pub warm: bool,
+    /// Correct the start on the coarse lattice (docs/method.md §3.8).
+    pub coarse: bool,
 }
 
 /// How the iteration ended.
@@ -81,6 +83,7 @@ pub(super) fn iterate(
         dt,
         couple,
         warm,
+        coarse,
     } = it;
     // The system matrix of formulation F1, frozen for the step.
     let mass = constraint.mass;
@@ -113,10 +116,17 @@ pub(super) fn iterate(
         walls: &boundary.walls,
     };
     chebyshev.reset();
+    b.coarse.start_step();
     let mut accelerate = params.solver == SolverKind::Chebyshev;
     // The ρ_c the step extrapolates with (reported also where it falls back).
     let rho = if accelerate { chebyshev.rho() } else { 0.0 };
     let single_sweep = solver.single_diagonal_sweep();
+    // The density rule, at the densities of a local step (the motion of the last outer
+    // iteration is `displacement`, passed in).
+    let density_rule = |displacement: f64, projections: &[Projection]| {
+        displacement < DENSITY_RULE_MOTION * params.displacement_tolerance
+            && average_compression(constraint, projections) <= params.density_tolerance
+    };
     let (mut outer, mut inner, mut displacement) = (0, 0, f64::INFINITY);
     let (mut converged, mut densities_known) = (false, false);
     // The outer iterations of the current pass (the second, if any, is the fallback).
@@ -152,12 +162,29 @@ pub(super) fn iterate(
         }
         let t = Instant::now();
         constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections)?;
-        let t_local = t.elapsed().as_secs_f64();
-        if k >= params.min_outer_iterations
-            && displacement < DENSITY_RULE_MOTION * params.displacement_tolerance
-            && average_compression(constraint, &b.projections) <= params.density_tolerance
+        let mut t_local = t.elapsed().as_secs_f64();
+        if coarse
+            && k % coarse::PERIOD == 0
+            && average_compression(constraint, &b.projections) > params.density_tolerance
         {
-            // The density rule: X^(k) is the result, and its densities are known.
+            // docs/method.md §3.8: the correction moves the start; the local step is
+            // taken again where it moved it.
+            let fluid = coarse::Fluid {
+                projections: &b.projections,
+                boundary,
+                rest_density: constraint.rest_density,
+                volume: constraint.mass / constraint.rest_density,
+                support_radius: params.support_radius(),
+                reach: coarse::REACH * gravity.norm() * dt * dt,
+            };
+            let (current, previous) = (&mut b.current, &mut b.previous);
+            if b.coarse.correct(current, previous, &fluid)? {
+                constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections)?;
+                t_local = t.elapsed().as_secs_f64();
+            }
+        }
+        if k >= params.min_outer_iterations && density_rule(displacement, &b.projections) {
+            // X^(k) is the result, and its densities are known.
             timings.local += t_local;
             (converged, densities_known) = (true, true);
             break;

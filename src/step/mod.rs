@@ -9,6 +9,7 @@
 //! reservation, a rebuilt grid, kept corrections, the body coupling's slots, a factorisation
 //! — fails before it moves the fluid, and puts back what it changed until then ([`undo`]).
 
+mod coarse;
 mod couple;
 mod finish;
 mod iterate;
@@ -71,6 +72,8 @@ pub(crate) struct StepBuffers {
     /// The stencil sizes (fluid, boundary members) that every thread's buffers of the local
     /// step have room for ([`crate::constraint::reserve_scratch`]).
     scratch_room: (usize, usize),
+    /// The coarse correction's lattice, kept from step to step (docs/method.md §3.8).
+    coarse: coarse::CoarseCorrection,
 }
 
 /// Everything one time step reads and writes, borrowed from the world that owns it.
@@ -161,6 +164,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 dt,
                 couple,
                 warm,
+                coarse: params.coarse_correction && !couple,
             },
             buffers,
             &mut timings,

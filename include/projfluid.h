@@ -275,8 +275,8 @@ typedef struct PfParams {
     /**
      * 1: correct the start of every step's outer iteration on a coarse lattice, moving the
      * whole fluid at once by the displacement that removes its compression on cells of two
-     * support radii, so that deep water needs no more outer iterations than shallow; 0: off.
-     * Not used in worlds with bodies. Default 1.
+     * support radii, so that deep water needs far fewer outer iterations; 0: off. Not used
+     * in worlds with bodies nor in the calm settings. Default 0.
      */
     uint32_t coarse_correction;
     /**
@@ -478,8 +478,8 @@ enum PfStatus pf_params_default(struct PfParams *out);
 
 /**
  * Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
- * at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0) and τ = 3e-4 times its
- * particle radius), under which a
+ * at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0), τ = 3e-4 times its
+ * particle radius, no warm start and no coarse correction), under which a
  * settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
  * field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
  * does not validate, leaving it unchanged.

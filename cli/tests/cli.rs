@@ -201,7 +201,7 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(json["particles"], 3840);
     assert_eq!(json["steps"], 3);
     assert_eq!(json["threads"], 2);
-    assert_eq!(json["coarse_correction"], true);
+    assert_eq!(json["coarse_correction"], false);
     assert_eq!(json["nan"], 0);
 
     let mut names: Vec<String> = std::fs::read_dir(&frames)

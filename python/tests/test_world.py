@@ -141,8 +141,8 @@ def test_params_default_to_the_c_librarys_and_round_trip(world: projfluid.World)
 
 
 def test_the_coarse_correction_is_a_switch_a_world_reports_back() -> None:
-    assert projfluid.Params().coarse_correction is True
-    assert projfluid.Params().calm().coarse_correction is True
+    assert projfluid.Params().coarse_correction is False
+    assert projfluid.Params(coarse_correction=True).calm().coarse_correction is False
     off = small_params(coarse_correction=False)
     assert off.coarse_correction is False and off.to_c().coarse_correction == 0
     assert small_params(coarse_correction=1).to_c().coarse_correction == 1

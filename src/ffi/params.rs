@@ -104,8 +104,8 @@ pub struct PfParams {
     pub warm_start: f64,
     /// 1: correct the start of every step's outer iteration on a coarse lattice, moving the
     /// whole fluid at once by the displacement that removes its compression on cells of two
-    /// support radii, so that deep water needs no more outer iterations than shallow; 0: off.
-    /// Not used in worlds with bodies. Default 1.
+    /// support radii, so that deep water needs far fewer outer iterations; 0: off. Not used
+    /// in worlds with bodies nor in the calm settings. Default 0.
     pub coarse_correction: u32,
     /// Smallest number of outer iterations per step (≥ 1). Default 1.
     pub min_outer_iterations: u32,
@@ -292,8 +292,8 @@ pub unsafe extern "C" fn pf_params_default(out: *mut PfParams) -> PfStatus {
 }
 
 /// Turns `*params` into the calm settings in place (uniform projection weighting, Chebyshev
-/// at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0) and τ = 3e-4 times its
-/// particle radius), under which a
+/// at a fixed ρ = 0.99 with γ = 0.5, the density rule off (η = 0), τ = 3e-4 times its
+/// particle radius, no warm start and no coarse correction), under which a
 /// settled tank stays at rest at 2–4 times the outer iterations of the defaults. Every other
 /// field is kept. Errors: `PF_ERROR_NULL_POINTER`; `PF_ERROR_INVALID_ARGUMENT` when `*params`
 /// does not validate, leaving it unchanged.

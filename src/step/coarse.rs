@@ -25,6 +25,12 @@ pub(super) const CELL_SIZE: f64 = 2.0;
 /// displacements, which are local and left to the fine iteration (docs/method.md §3.8).
 pub(super) const REACH: f64 = 2.0;
 
+/// The fluid's average compression (dimensionless) above which the correction is made, or
+/// above η where that is larger: the default η. Below it what is left is the fine iteration's
+/// to resolve, and a run with a tighter η, or with the density rule off, converges without
+/// the correction moving it again.
+pub(super) const THRESHOLD: f64 = 3e-4;
+
 /// The correction is made before the first global step of a step and again after every
 /// this many outer iterations: a compression that the fine iteration's extrapolation carries
 /// up a column as a travelling pulse is spread out before it grows (docs/method.md §3.8).
@@ -224,6 +230,9 @@ pub(super) struct Fluid<'a> {
     pub rest_density: f64,
     /// Each particle's rest volume m/ρ0 (m³).
     pub volume: f64,
+    /// The average compression the fine iteration may leave (dimensionless): the correction
+    /// removes only what exceeds it.
+    pub tolerated: f64,
     /// Support radius H (m).
     pub support_radius: f64,
     /// The most any particle is moved (m).
@@ -340,7 +349,7 @@ impl CoarseCorrection {
             self.extent[c].include(x);
             self.fill[c] += fluid.volume / cell_volume;
             if p.density >= SURFACE_DENSITY * rest {
-                self.excess[c] += fluid.volume * (p.density / rest - 1.0);
+                self.excess[c] += fluid.volume * (p.density / rest - 1.0 - fluid.tolerated);
             }
         }
         for b in fluid.boundary.positions.iter() {

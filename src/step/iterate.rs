@@ -165,7 +165,8 @@ pub(super) fn iterate(
         let mut t_local = t.elapsed().as_secs_f64();
         if coarse
             && k % coarse::PERIOD == 0
-            && average_compression(constraint, &b.projections) > params.density_tolerance
+            && average_compression(constraint, &b.projections)
+                > params.density_tolerance.max(coarse::THRESHOLD)
         {
             // docs/method.md §3.8: the correction moves the start; the local step is
             // taken again where it moved it.
@@ -174,6 +175,7 @@ pub(super) fn iterate(
                 boundary,
                 rest_density: constraint.rest_density,
                 volume: constraint.mass / constraint.rest_density,
+                tolerated: params.density_tolerance.max(coarse::THRESHOLD),
                 support_radius: params.support_radius(),
                 reach: coarse::REACH * gravity.norm() * dt * dt,
             };

@@ -55,18 +55,19 @@ int main(int argc, char **argv) {
     CHECK(params.particle_radius == 0.025);
     CHECK(params.solver == PF_SOLVER_CHEBYSHEV);
     CHECK(params.gravity[1] == -9.81);
-    CHECK(params.coarse_correction == 1);
+    CHECK(params.coarse_correction == 0);
     params.threads = 2;
     OK(pf_params_validate(&params));
 
-    /* The calm settings change the weighting, tau and Chebyshev's settings only. */
+    /* The calm settings change the weighting, tau, Chebyshev's settings and the coarse
+       correction only. */
     PfParams calm = params;
     OK(pf_params_calm(&calm));
     CHECK(calm.projection_weight == PF_WEIGHT_UNIFORM);
     CHECK(calm.displacement_tolerance == 3e-4 * params.particle_radius);
     CHECK(calm.chebyshev_rho == 0.99 && calm.chebyshev_gamma == 0.5);
     CHECK(calm.chebyshev_auto_rho == 0);
-    CHECK(calm.coarse_correction == params.coarse_correction);
+    CHECK(calm.coarse_correction == 0);
     CHECK(calm.threads == 2 && calm.solver == params.solver);
     CHECK(calm.stiffness == params.stiffness && calm.dt_max == params.dt_max);
     OK(pf_params_validate(&calm));
@@ -79,15 +80,15 @@ int main(int argc, char **argv) {
     OK(pf_world_get_params(world, &back));
     CHECK(memcmp(&back.particle_radius, &params.particle_radius, sizeof(double)) == 0);
     CHECK(back.threads == 2 && back.max_outer_iterations == params.max_outer_iterations);
-    CHECK(back.coarse_correction == 1);
-
-    /* The coarse correction turned off is kept by the world. */
-    PfParams coarse_off = params;
-    coarse_off.coarse_correction = 0;
-    PfWorld *plain = NULL;
-    OK(pf_world_create(&coarse_off, &plain));
-    OK(pf_world_get_params(plain, &back));
     CHECK(back.coarse_correction == 0);
+
+    /* The coarse correction turned on is kept by the world. */
+    PfParams coarse_on = params;
+    coarse_on.coarse_correction = 1;
+    PfWorld *plain = NULL;
+    OK(pf_world_create(&coarse_on, &plain));
+    OK(pf_world_get_params(plain, &back));
+    CHECK(back.coarse_correction == 1);
     pf_world_destroy(plain);
 
     const float lo[3] = {-0.00625f, -0.00625f, -0.00625f};

@@ -127,10 +127,10 @@ class Params:
     a being that step's displacement from its prediction per Δt² (0 starts every step from
     its prediction s, the default). Not used in worlds with bodies; 0 in the calm settings."""
     coarse_correction: bool = bool(_C_DEFAULTS.coarse_correction)
-    """Correct the start of every step's outer iteration on a coarse lattice (True, the
+    """Correct the start of every step's outer iteration on a coarse lattice (False, the
     default): the whole fluid moves at once by the displacement that removes its compression
-    on cells of two support radii, so that deep water needs no more outer iterations than
-    shallow. Not used in worlds with bodies."""
+    on cells of two support radii, so that deep water needs far fewer outer iterations. Not
+    used in worlds with bodies nor in the calm settings."""
     min_outer_iterations: int = _C_DEFAULTS.min_outer_iterations
     """Smallest number of outer iterations per step (≥ 1)."""
     max_outer_iterations: int = _C_DEFAULTS.max_outer_iterations

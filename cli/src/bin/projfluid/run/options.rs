@@ -25,8 +25,8 @@ pub(crate) struct ParamOptions {
     #[arg(long, value_name = "FRACTION", allow_negative_numbers = true)]
     pub(crate) warm_start: Option<f64>,
     /// Correct the start of every step's outer iteration on a coarse lattice, moving the
-    /// whole fluid at once to remove its compression, so that deep water needs no more outer
-    /// iterations than shallow (on by default; not used in worlds with bodies).
+    /// whole fluid at once to remove its compression, so that deep water needs far fewer
+    /// outer iterations (off by default; not used in worlds with bodies).
     #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
     pub(crate) coarse_correction: Option<bool>,
     /// Worker threads (0 = one per core).

@@ -198,22 +198,22 @@ fn rho_auto_is_read_written_and_checked() {
     );
 }
 
-/// `solver.coarse_correction` is on unless a scene turns it off, and a scene written out
+/// `solver.coarse_correction` is off unless a scene turns it on, and a scene written out
 /// keeps the setting.
 #[test]
 fn coarse_correction_is_read_and_written() {
-    assert!(Scene::from_json(GOOD).unwrap().params.coarse_correction);
-    let off = GOOD.replacen(
+    assert!(!Scene::from_json(GOOD).unwrap().params.coarse_correction);
+    let on = GOOD.replacen(
         "\"fluid_blocks\"",
-        "\"solver\": {\"coarse_correction\": false}, \"fluid_blocks\"",
+        "\"solver\": {\"coarse_correction\": true}, \"fluid_blocks\"",
         1,
     );
-    let scene = Scene::from_json(&off).unwrap();
-    assert!(!scene.params.coarse_correction);
+    let scene = Scene::from_json(&on).unwrap();
+    assert!(scene.params.coarse_correction);
     let json = scene.to_json();
-    assert!(json.contains("\"coarse_correction\": false"), "{json}");
+    assert!(json.contains("\"coarse_correction\": true"), "{json}");
     let again = Scene::from_json(&json).unwrap();
-    assert!(!again.params.coarse_correction);
+    assert!(again.params.coarse_correction);
     assert_eq!(again, scene);
     let bad = GOOD.replacen(
         "\"fluid_blocks\"",

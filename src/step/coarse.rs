@@ -195,7 +195,6 @@ impl Extent {
 /// only on the world's state (a checkpoint resumes bit for bit).
 #[derive(Clone, Debug, Default)]
 pub(crate) struct CoarseCorrection {
-    lattice: Option<Lattice>,
     cells: Vec<Cell>,
     /// Fluid volume per cell over the cell's volume.
     fill: Vec<f64>,
@@ -281,9 +280,7 @@ impl CoarseCorrection {
         ] {
             reserve_total(v, cells)?;
         }
-        self.lattice = Some(lattice);
-        self.classify(current, fluid);
-        if self.excess.iter().all(|&e| e == 0.0) {
+        if !self.classify(&lattice, current, fluid) || self.excess.iter().all(|&e| e == 0.0) {
             return Ok(false);
         }
         self.start_from_last(&lattice);
@@ -321,15 +318,19 @@ impl CoarseCorrection {
 
     /// Marks fluid, solid and air cells, and sums every fluid cell's fill and excess volume
     /// (the excess as the right-hand side, over the cell edge).
-    fn classify(&mut self, current: &[Vec3], fluid: &Fluid) {
-        let lattice = self.lattice.expect("set by the caller");
+    /// Returns false, classifying nothing, where a particle lies outside the lattice (a
+    /// position that is not a number).
+    fn classify(&mut self, lattice: &Lattice, current: &[Vec3], fluid: &Fluid) -> bool {
         let cells = lattice.len();
         self.slot_cell.clear();
         self.slot_cell.par_extend(
             current
                 .par_iter()
-                .map(|x| lattice.cell(x).expect("the lattice covers the fluid") as u32),
+                .map(|x| lattice.cell(x).map_or(u32::MAX, |c| c as u32)),
         );
+        if self.slot_cell.contains(&u32::MAX) {
+            return false;
+        }
         self.cells.clear();
         self.cells.resize(cells, Cell::Air);
         self.fill.clear();
@@ -387,6 +388,7 @@ impl CoarseCorrection {
         self.theta.clear();
         self.theta
             .extend(self.fill.iter().map(|f| (f - 0.5).clamp(THETA_MIN, 1.0)));
+        true
     }
 
     /// Starts φ from the last solve's where the lattices share fluid cells, from 0 elsewhere.

@@ -20,10 +20,11 @@ use std::collections::TryReserveError;
 /// The edge of a coarse cell, in support radii H.
 pub(super) const CELL_SIZE: f64 = 2.0;
 
-/// The largest displacement the correction gives a particle, in multiples of |g|·Δt²: what
-/// holding a column up against gravity takes, with room to spare. Impacts need far larger
-/// displacements, which are local and left to the fine iteration (docs/method.md §3.8).
-pub(super) const REACH: f64 = 2.0;
+/// The largest displacement the correction gives a particle, in multiples of |g|·Δt²:
+/// several times what holding a column up against gravity takes, so that the column's weight
+/// is carried in one move even where it has just landed; the far larger displacements of a
+/// hard impact are local and left to the fine iteration (docs/method.md §3.8).
+pub(super) const REACH: f64 = 8.0;
 
 /// The fluid's average compression (dimensionless) above which the correction is made, or
 /// above η where that is larger: the default η. Below it what is left is the fine iteration's

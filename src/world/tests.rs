@@ -195,10 +195,10 @@ mod step {
     /// The coarse correction (docs/method.md §3.8) holds a deep column up in a few outer
     /// iterations where the local and global steps alone carry its weight up one support
     /// radius per iteration: on a collapsing column 60 particles (30 support radii) tall it
-    /// takes at most 55 % of the outer iterations over the first 0.4 s (48 %, measured),
+    /// takes at most 55 % of the outer iterations over the first 0.4 s (47 %, measured),
     /// while every step still ends within the stopping rules, the energy never rises above
     /// its start, and the surge's mean horizontal speed at 0.4 s stays within 6 % of the
-    /// speed without it (4.6 % lower, measured).
+    /// speed without it (2.9 % lower, measured).
     #[test]
     fn the_coarse_correction_carries_a_deep_column() {
         let run = |coarse: bool| {
@@ -578,7 +578,7 @@ mod step {
 /// compressed by several per cent, or go through the wall: the density rule bounds the average
 /// over the pool and the spray together, which a few particles hardly move. The fine
 /// iteration is measured alone: the coarse correction (docs/method.md §3.8) also pushes a lone
-/// drop out of a wall, by up to 2|g|Δt² per correction.
+/// drop out of a wall, by up to 8|g|Δt² per correction.
 #[test]
 fn spray_hitting_a_wall_stays_nearly_incompressed() {
     let worst = |floor: Option<f64>, block: [usize; 3], velocity: Vec3| {

@@ -224,24 +224,16 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
             )));
         }
     };
-    let auto_rho = match field!(chebyshev_auto_rho) {
-        0 => false,
-        1 => true,
-        n => {
-            return Err(Failure::invalid(format!(
-                "params->chebyshev_auto_rho must be 0 or 1, got {n}"
-            )));
-        }
+    // A 0/1 field named `name`.
+    let switch = |value: u32, name: &str| match value {
+        0 => Ok(false),
+        1 => Ok(true),
+        n => Err(Failure::invalid(format!(
+            "params->{name} must be 0 or 1, got {n}"
+        ))),
     };
-    let coarse_correction = match field!(coarse_correction) {
-        0 => false,
-        1 => true,
-        n => {
-            return Err(Failure::invalid(format!(
-                "params->coarse_correction must be 0 or 1, got {n}"
-            )));
-        }
-    };
+    let auto_rho = switch(field!(chebyshev_auto_rho), "chebyshev_auto_rho")?;
+    let coarse_correction = switch(field!(coarse_correction), "coarse_correction")?;
     let count = |n: u32| n as usize;
     let params = Params {
         particle_radius: field!(particle_radius),

@@ -61,6 +61,23 @@ mod step {
         s
     }
 
+    /// Steps a collapsing column until `seconds`, every step within the stopping rules and the
+    /// energy never above its start, and returns the outer iterations taken and the surge's
+    /// mean horizontal speed (m/s) at the end.
+    fn collapse(mut world: World, seconds: f64, what: &str) -> (usize, f64) {
+        let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
+        let (initial, mut highest, mut outer) = (energy(&world), f64::MIN, 0);
+        while world.time() < seconds {
+            let s = step_within_rules(&mut world, what);
+            outer += s.outer_iterations;
+            highest = highest.max(energy(&world));
+        }
+        assert!(highest <= initial, "{what}: {highest} J from {initial} J");
+        let v = world.velocities();
+        let surge = v.iter().map(|v| v.x).sum::<f64>() / v.len() as f64;
+        (outer, surge)
+    }
+
     /// A block of `count` particles from (0.05, 0.05, 0.05) m in a container from
     /// −r/4 to `max` (m).
     fn block_in_box(params: Params, max: Vec3, count: [usize; 3]) -> World {
@@ -162,21 +179,8 @@ mod step {
             // A column 30 particles tall, which a step lifts off the floor through 15
             // support radii.
             let top = Vec3::new(1.00625, 1.80625, 0.25625);
-            let mut world = block_in_box(params, top, [6, 30, 4]);
-            let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
-            let (initial, mut highest, mut outer) = (energy(&world), f64::MIN, 0);
-            while world.time() < 0.5 {
-                let s = step_within_rules(&mut world, &format!("f {share}"));
-                outer += s.outer_iterations;
-                highest = highest.max(energy(&world));
-            }
-            assert!(
-                highest <= initial,
-                "f {share}: {highest} J from {initial} J"
-            );
-            let v = world.velocities();
-            let surge = v.iter().map(|v| v.x).sum::<f64>() / v.len() as f64;
-            (outer, surge)
+            let world = block_in_box(params, top, [6, 30, 4]);
+            collapse(world, 0.5, &format!("f {share}"))
         };
         let (cold, warm, warmer) = (run(0.0), run(0.45), run(0.8));
         assert!(
@@ -207,21 +211,8 @@ mod step {
                 ..Params::default()
             };
             let top = Vec3::new(1.50625, 3.50625, 0.45625);
-            let mut world = block_in_box(params, top, [16, 60, 8]);
-            let energy = |w: &World| w.kinetic_energy() + w.potential_energy();
-            let (initial, mut highest, mut outer) = (energy(&world), f64::MIN, 0);
-            while world.time() < 0.4 {
-                let s = step_within_rules(&mut world, &format!("coarse {coarse}"));
-                outer += s.outer_iterations;
-                highest = highest.max(energy(&world));
-            }
-            assert!(
-                highest <= initial,
-                "coarse {coarse}: {highest} J from {initial} J"
-            );
-            let v = world.velocities();
-            let surge = v.iter().map(|v| v.x).sum::<f64>() / v.len() as f64;
-            (outer, surge)
+            let world = block_in_box(params, top, [16, 60, 8]);
+            collapse(world, 0.4, &format!("coarse {coarse}"))
         };
         let (fine, coarse) = (run(false), run(true));
         assert!(

@@ -1,14 +1,27 @@
-//! Non-pressure forces: what acts on the fluid besides the density constraint (viscosity
-//! today; surface tension would join here). They change the velocities after a step's
-//! positions are final (docs/method.md §1.3).
+//! Non-pressure forces: what acts on the fluid besides the density constraint (the physical
+//! viscosity and the XSPH filter). They change the velocities after a step's positions are
+//! final (docs/method.md §1.3).
 
 use crate::Vec3;
+use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use crate::params::Params;
+use viscosity::Viscosity;
 use xsph::Xsph;
 
+mod viscosity;
 mod xsph;
+
+/// What a force reads besides the fluid: the constraint's constants, the step's
+/// neighbourhoods (lists found on the prediction), the boundary and the step size.
+pub(crate) struct Forcing<'a> {
+    pub constraint: &'a DensityConstraint,
+    pub nb: &'a Neighborhood<'a>,
+    pub boundary: &'a Boundary,
+    /// Step size Δt (s).
+    pub dt: f64,
+}
 
 /// A force other than pressure, applied to the fluid's velocities at the end of a step.
 pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
@@ -18,20 +31,18 @@ pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
         Ok(())
     }
 
-    /// Changes `fluid.velocities` (m/s) given the final positions and densities and the
-    /// step's neighbourhoods; `scratch` is a per-particle buffer the force may use.
-    fn apply(
-        &mut self,
-        constraint: &DensityConstraint,
-        nb: &Neighborhood,
-        fluid: &mut Fluid,
-        scratch: &mut Vec<Vec3>,
-    );
+    /// Changes `fluid.velocities` (m/s) given the final positions and densities and what
+    /// `f` holds; `scratch` is a per-particle buffer the force may use.
+    fn apply(&mut self, f: &Forcing, fluid: &mut Fluid, scratch: &mut Vec<Vec3>);
 }
 
 /// The non-pressure forces that `params` ask for, in the order they apply.
 pub(crate) fn from_params(params: &Params) -> Vec<Box<dyn NonPressureForce>> {
     let mut forces: Vec<Box<dyn NonPressureForce>> = Vec::new();
+    if params.kinematic_viscosity > 0.0 {
+        let walls = params.no_slip;
+        forces.push(Box::new(Viscosity::new(params.kinematic_viscosity, walls)));
+    }
     if params.viscosity > 0.0 {
         forces.push(Box::new(Xsph::new(params.viscosity)));
     }

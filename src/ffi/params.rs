@@ -262,6 +262,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         dt_initial: field!(dt_initial),
         viscosity: field!(viscosity),
         threads: count(field!(threads)),
+        ..Params::default()
     };
     params
         .validate()

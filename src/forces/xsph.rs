@@ -1,9 +1,8 @@
 //! XSPH viscosity (docs/method.md §1.3): v_i ← v_i + c Σ_j (m/ρ_j)(v_j − v_i) W_ij, a filter
 //! that blends each velocity with its neighbours'.
 
-use super::NonPressureForce;
+use super::{Forcing, NonPressureForce};
 use crate::Vec3;
-use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use rayon::prelude::*;
 
@@ -30,13 +29,8 @@ impl NonPressureForce for Xsph {
         crate::reserve::reserve_total(&mut self.volumes, particles)
     }
 
-    fn apply(
-        &mut self,
-        constraint: &DensityConstraint,
-        nb: &Neighborhood,
-        fluid: &mut Fluid,
-        scratch: &mut Vec<Vec3>,
-    ) {
+    fn apply(&mut self, f: &Forcing, fluid: &mut Fluid, scratch: &mut Vec<Vec3>) {
+        let (constraint, nb) = (f.constraint, f.nb);
         let (c, mass, volumes) = (self.coefficient, constraint.mass, &mut self.volumes);
         volumes.clear();
         volumes.par_extend(fluid.densities.par_iter().map(|rho| mass / rho));

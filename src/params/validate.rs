@@ -63,6 +63,13 @@ impl Params {
                 "must lie in [0, 1]",
             ));
         }
+        if !(self.kinematic_viscosity.is_finite() && self.kinematic_viscosity >= 0.0) {
+            return Err(Error::invalid(
+                "kinematic_viscosity",
+                self.kinematic_viscosity,
+                "must be finite and not negative (m²/s; 0 turns it off)",
+            ));
+        }
         if !(self.density_tolerance.is_finite() && (0.0..1.0).contains(&self.density_tolerance)) {
             return Err(Error::invalid(
                 "density_tolerance",

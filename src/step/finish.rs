@@ -7,7 +7,7 @@ use super::iterate::Outcome;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
-use crate::forces::NonPressureForce;
+use crate::forces::{Forcing, NonPressureForce};
 use crate::reduce;
 use crate::stats::{StepStats, StepTimings};
 use rayon::prelude::*;
@@ -63,9 +63,15 @@ pub(super) fn finish(
     } else {
         constraint.densities(&fluid.positions, &nb, &mut fluid.densities);
     }
+    let forcing = Forcing {
+        constraint,
+        nb: &nb,
+        boundary,
+        dt,
+    };
     for force in forces.iter_mut() {
         // X^(k−1) of the finished iteration serves as the forces' scratch.
-        force.apply(constraint, &nb, fluid, &mut b.previous);
+        force.apply(&forcing, fluid, &mut b.previous);
     }
     let rest = constraint.rest_density;
     let errors = |rho: &f64| (rho / rest - 1.0).max(0.0);

@@ -1,0 +1,195 @@
+//! The implicit viscosity solve (docs/method.md §13) against analytic viscous flows.
+
+use projfluid::boundary::Aabb;
+use projfluid::{Params, Vec3, World};
+
+/// Fully developed flow under gravity down a vertical duct of rectangular cross-section
+/// [−a, a] × [−b, b] with no-slip walls (m/s, downwards), at (x, z) from the duct's axis:
+/// the Fourier series of the Poiseuille problem in a rectangle, with the pressure gradient
+/// replaced by the weight ρg (the column's free ends keep its pressure at zero).
+fn duct_speed(g: f64, nu: f64, a: f64, b: f64, x: f64, z: f64) -> f64 {
+    let pi = std::f64::consts::PI;
+    let mut sum = 0.0;
+    for k in 0..200 {
+        let n = (2 * k + 1) as f64;
+        let sign = if k % 2 == 0 { 1.0 } else { -1.0 };
+        let m = n * pi / (2.0 * a);
+        let decay = if (m * b) > 700.0 {
+            (m * (z.abs() - b)).exp()
+        } else {
+            (m * z).cosh() / (m * b).cosh()
+        };
+        sum += sign / n.powi(3) * (1.0 - decay) * (m * x).cos();
+    }
+    16.0 * a * a * g / (nu * pi.powi(3)) * sum
+}
+
+/// A column of `nx` × `ny` × `nz` particles falls down a duct that it fills, held back by the
+/// walls' friction alone; returns the RMS difference between the downward speeds of the
+/// particles in the middle of the column and the fully developed duct flow, over the largest
+/// analytic speed, after `seconds`.
+fn duct_error(nu: f64, n: [usize; 3], seconds: f64) -> f64 {
+    let params = Params {
+        kinematic_viscosity: nu,
+        ..Params::with_radius(0.00125)
+    };
+    let (r, d) = (params.particle_radius, params.spacing());
+    let g = -params.gravity[1];
+    let mut world = World::new(params).unwrap();
+    // The walls' particle planes lie r/4 beyond the fluid's extent (a particle's cube of
+    // edge d), as in the built-in scenes.
+    let gap = 0.25 * r;
+    let width = |count: usize| count as f64 * d;
+    let container = Aabb {
+        min: Vec3::new(-gap, 0.0, -gap),
+        max: Vec3::new(width(n[0]) + gap, 1.0, width(n[2]) + gap),
+    };
+    world.add_container(container, 1).unwrap();
+    let top = 1.0 - width(n[1]) - 4.0 * d;
+    world
+        .add_fluid_block(Vec3::new(r, top, r), n, Vec3::zeros())
+        .unwrap();
+    while world.time() < seconds {
+        world.step().unwrap();
+    }
+    let (a, b) = (width(n[0]) / 2.0, width(n[2]) / 2.0);
+    let x = world.positions();
+    let v = world.velocities();
+    let ys: Vec<f64> = x.iter().map(|p| p.y).collect();
+    let (low, high) = ys
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &y| {
+            (l.min(y), h.max(y))
+        });
+    let third = (high - low) / 3.0;
+    let (mut sum, mut count, mut most) = (0.0, 0, 0.0f64);
+    for (p, v) in x.iter().zip(&v) {
+        if p.y < low + third || p.y > high - third {
+            continue;
+        }
+        let exact = duct_speed(g, nu, a, b, p.x - a, p.z - b);
+        most = most.max(exact);
+        sum += (-v.y - exact).powi(2);
+        count += 1;
+    }
+    let rms = (sum / count as f64).sqrt();
+    rms / most
+}
+
+#[test]
+fn a_column_falling_down_a_duct_takes_the_analytic_profile() {
+    for nu in [1e-2, 1e-1] {
+        let error = duct_error(nu, [16, 32, 24], 0.1);
+        assert!(error < 0.05, "nu {nu}: RMS error {:.1} %", 100.0 * error);
+    }
+}
+
+/// A ball of `n`³ particles without gravity or walls, spinning at `omega` (rad/s) about the
+/// y axis through its centre and sheared by `shear` (1/s: v_x grows with y), with the
+/// kinematic viscosity `nu` (m²/s) and no XSPH filter.
+fn spinning_ball(nu: f64, omega: f64, shear: f64, threads: usize) -> World {
+    let params = Params {
+        kinematic_viscosity: nu,
+        viscosity: 0.0,
+        gravity: [0.0; 3],
+        threads,
+        ..Params::with_radius(0.01)
+    };
+    let d = params.spacing();
+    let mut world = World::new(params).unwrap();
+    let n = 12;
+    world
+        .add_fluid_block(Vec3::zeros(), [n, n, n], Vec3::zeros())
+        .unwrap();
+    let centre = Vec3::repeat(0.5 * (n - 1) as f64 * d);
+    let v: Vec<Vec3> = world
+        .positions()
+        .iter()
+        .map(|p| {
+            let r = p - centre;
+            Vec3::new(omega * r.z + shear * r.y, 0.0, -omega * r.x)
+        })
+        .collect();
+    world.set_velocities(&v).unwrap();
+    world
+}
+
+/// Linear momentum (kg·m/s per particle mass) and angular momentum about the centre of mass
+/// (kg·m²/s per particle mass) of the fluid.
+fn momenta(world: &World) -> (Vec3, Vec3) {
+    let (x, v) = (world.positions(), world.velocities());
+    let centre = x.iter().sum::<Vec3>() / x.len() as f64;
+    let linear = v.iter().sum::<Vec3>();
+    let angular = x.iter().zip(&v).map(|(x, v)| (x - centre).cross(v)).sum();
+    (linear, angular)
+}
+
+fn kinetic(world: &World) -> f64 {
+    world
+        .velocities()
+        .iter()
+        .map(|v| 0.5 * v.norm_squared())
+        .sum()
+}
+
+/// The viscous forces act along the line between two particles, equal and opposite, so a
+/// free ball keeps its momentum and its angular momentum, and a rigid spin is not slowed;
+/// a shear is: it loses most of its energy within a few viscous times, the spin part of it
+/// staying.
+#[test]
+fn viscosity_keeps_momentum_and_spin_and_damps_shear() {
+    let nu = 2e-2;
+    let mut spin = spinning_ball(nu, 2.0, 0.0, 0);
+    let mut sheared = spinning_ball(nu, 0.0, 2.0, 0);
+    let (_, spin_start) = momenta(&spin);
+    let (linear_start, shear_start) = momenta(&sheared);
+    let (spin_energy, shear_energy) = (kinetic(&spin), kinetic(&sheared));
+    spin.advance(0.2).unwrap();
+    sheared.advance(0.2).unwrap();
+    let (_, spin_end) = momenta(&spin);
+    let (linear_end, shear_end) = momenta(&sheared);
+    // Up to the solve's tolerance, against the sum of the particles' speeds.
+    let scale: f64 = sheared.velocities().iter().map(|v| v.norm()).sum();
+    let drift = (linear_end - linear_start).norm() / scale;
+    assert!(drift < 1e-6, "momentum drifted by {drift:e} of Σ|v|");
+    let lost = (spin_end - spin_start).norm() / spin_start.norm();
+    assert!(
+        lost < 0.01,
+        "the spin's angular momentum changed by {:.2} %",
+        100.0 * lost
+    );
+    let lost = (shear_end - shear_start).norm() / shear_start.norm();
+    assert!(
+        lost < 0.01,
+        "the shear's angular momentum changed by {:.2} %",
+        100.0 * lost
+    );
+    let kept = kinetic(&spin) / spin_energy;
+    assert!(
+        kept > 0.9,
+        "the spin kept {:.1} % of its energy",
+        100.0 * kept
+    );
+    // A simple shear is half spin, half strain: the strain's energy, half of the total,
+    // goes into heat.
+    let kept = kinetic(&sheared) / shear_energy;
+    assert!(
+        kept < 0.7,
+        "the shear kept {:.1} % of its energy",
+        100.0 * kept
+    );
+}
+
+/// The solve's sums are taken in a fixed order: one and two threads give the same bits.
+#[test]
+fn viscosity_is_the_same_on_one_and_two_threads() {
+    let runs: Vec<Vec<Vec3>> = [1, 2]
+        .into_iter()
+        .map(|threads| {
+            let mut world = spinning_ball(1e-2, 1.0, 1.0, threads);
+            world.advance(0.05).unwrap();
+            world.velocities()
+        })
+        .collect();
+    assert!(runs[0] == runs[1]);
+}

@@ -4,9 +4,9 @@
 mod support;
 
 use projfluid::SolverKind;
-use projfluid_lab::validation::hydrostatic;
 use projfluid_lab::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
 use projfluid_lab::validation::reference::Measurements;
+use projfluid_lab::validation::{hydrostatic, poiseuille};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use support::{projfluid, projfluid_ok};
@@ -192,6 +192,25 @@ fn tank_at_rest_comes_to_rest() {
     );
 }
 
+/// Fluid falling down a duct, held back only by the no-slip walls, takes the analytic
+/// Poiseuille profile of the duct at ν = 0.01 and 0.1 m²/s (`projfluid validate poiseuille`'s
+/// defaults): RMS error within 5 % of the peak speed, and the flux within 10 %.
+#[test]
+fn duct_flow_takes_the_analytic_profile_at_two_viscosities() {
+    let report = poiseuille::simulate(&poiseuille::Setup::default(), |_| {}).unwrap();
+    assert_eq!(report.runs.len(), 2);
+    for run in &report.runs {
+        assert!(
+            run.error < 0.05 && (run.flux_ratio - 1.0).abs() < 0.10,
+            "nu {}: RMS error {:.1} % of {:.4} m/s, flux ratio {:.3}",
+            run.viscosity,
+            100.0 * run.error,
+            run.peak,
+            run.flux_ratio
+        );
+    }
+}
+
 /// `name` under this file's directory for test files, emptied.
 fn scratch(name: &str) -> PathBuf {
     support::scratch("validation", name)
@@ -237,7 +256,7 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 12] = [
+    let cases: [&[&str]; 15] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
         &[
             "validate",
@@ -306,6 +325,30 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
             "--out",
             out_dir,
         ],
+        &[
+            "validate",
+            "poiseuille",
+            "--viscosity",
+            "0.1,-1",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "poiseuille",
+            "--resolution",
+            "2",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "poiseuille",
+            "--walls",
+            "field",
+            "--out",
+            out_dir,
+        ],
     ];
     for args in cases {
         let out = projfluid(args);
@@ -320,6 +363,32 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
         !dir.exists(),
         "a rejected command must not create its output directory"
     );
+}
+
+#[test]
+fn cli_poiseuille_writes_its_table_profile_and_chart() {
+    let dir = scratch("cli_poiseuille");
+    let stdout = projfluid_ok(&[
+        "validate",
+        "poiseuille",
+        "--resolution",
+        "6",
+        "--viscosity",
+        "0.1",
+        "--duration",
+        "0.02",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("flow down a duct"), "{stdout}");
+    assert!(stdout.contains("1.0e-1"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("poiseuille_profile.csv")).unwrap();
+    // A header and one row per layer across the duct.
+    assert_eq!(csv.lines().count(), 1 + 6, "{csv}");
+    let png = std::fs::read(dir.join("poiseuille_profile.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
 }
 
 #[test]

@@ -1,13 +1,14 @@
 //! `projfluid validate`: the Martin & Moyce dam break against the 1952 measurements, the
-//! MARIN dam break past a box against Kleefsman et al. (2005), and a tank at rest against
-//! hydrostatics. Prints a table and writes CSV and PNG files.
+//! MARIN dam break past a box against Kleefsman et al. (2005), a tank at rest against
+//! hydrostatics, and viscous flow down a duct against its analytic profile. Prints a table
+//! and writes CSV and PNG files.
 
 use crate::{Failure, solver_parser};
 use clap::{Args, Subcommand};
 use projfluid::scene::ContainerWalls;
 use projfluid::{Error, SolverKind};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce};
+use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce, poiseuille};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -23,6 +24,9 @@ pub(crate) enum ValidateCommand {
     Kleefsman(KleefsmanArgs),
     /// A tank of water at rest: compression, residual motion, height and pressure profile.
     Hydrostatic(HydrostaticArgs),
+    /// Viscous flow down a duct (Poiseuille flow driven by the weight): the speed across the
+    /// duct against the analytic profile, at each viscosity.
+    Poiseuille(PoiseuilleArgs),
 }
 
 /// Options every validation takes.
@@ -167,12 +171,40 @@ pub(crate) struct HydrostaticArgs {
     common: CommonArgs,
 }
 
+/// Options of `projfluid validate poiseuille`.
+#[derive(Args)]
+pub(crate) struct PoiseuilleArgs {
+    /// Kinematic viscosities to run, in m²/s, comma-separated.
+    #[arg(
+        long,
+        value_name = "NU,...",
+        default_value = "0.01,0.1",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    viscosity: Vec<f64>,
+    /// Particles across the duct's narrow side (4–64; the wide side holds 3/2 as many).
+    #[arg(long, value_name = "N", default_value_t = 16)]
+    resolution: usize,
+    /// Simulated time per run, in seconds.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 0.1,
+        allow_negative_numbers = true
+    )]
+    duration: f64,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
 /// `projfluid validate …`.
 pub(crate) fn validate(command: &ValidateCommand) -> Result<(), Failure> {
     match command {
         ValidateCommand::MartinMoyce(args) => martin_moyce(args),
         ValidateCommand::Kleefsman(args) => kleefsman(args),
         ValidateCommand::Hydrostatic(args) => hydrostatic(args),
+        ValidateCommand::Poiseuille(args) => poiseuille(args),
     }
 }
 
@@ -378,6 +410,40 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
         report.text(),
         files.profile_csv.display(),
         files.pressure_png.display()
+    );
+    print(&text)
+}
+
+fn poiseuille(args: &PoiseuilleArgs) -> Result<(), Failure> {
+    if args.common.walls() == ContainerWalls::Field {
+        return Err(Failure::Input(
+            "--walls field: the duct's walls hold the fluid with no slip, which walls built as \
+             fields cannot; use --walls particles"
+                .into(),
+        ));
+    }
+    let setup = poiseuille::Setup {
+        viscosities: args.viscosity.clone(),
+        across: args.resolution,
+        duration: args.duration,
+        solver: args.common.solver,
+        threads: args.common.threads,
+        ..poiseuille::Setup::default()
+    };
+    setup.validate().map_err(|e| match e {
+        Error::InvalidArgument { field, message } => {
+            Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
+        }
+        other => input(other),
+    })?;
+    create_dir(&args.common.out)?;
+    let report = poiseuille::simulate(&setup, |_| {}).map_err(runtime)?;
+    let files = poiseuille::write_report(&args.common.out, &report).map_err(runtime)?;
+    let text = format!(
+        "{}\nwrote {}, {}\n",
+        report.text(),
+        files.profile_csv.display(),
+        files.profile_png.display()
     );
     print(&text)
 }

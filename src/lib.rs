@@ -23,6 +23,8 @@ mod error;
 pub mod ffi;
 mod fluid;
 mod forces;
+#[cfg(feature = "gpu")]
+mod gpu;
 pub mod io;
 pub mod kernel;
 pub mod neighbors;
@@ -43,7 +45,7 @@ mod world;
 pub use emitter::{Emitter, EmitterShape, EmitterSpec, EmitterState};
 pub use error::Error;
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
-pub use world::{BodyId, EmitterId, GridParts, SinkId, World, WorldState};
+pub use world::{Backend, BodyId, EmitterId, GridParts, SinkId, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).
 pub type Vec3 = nalgebra::Vector3<f64>;

@@ -5,6 +5,7 @@
 //! particles and measures, [`stepping`] advances time, [`state`] exports and imports the
 //! exact state, and [`snapshot`] sorts the particles for the readings taken between steps.
 
+mod backend;
 mod bodies;
 mod emitters;
 mod fill;
@@ -17,6 +18,7 @@ mod stepping;
 #[cfg(test)]
 mod tests;
 
+pub use backend::Backend;
 pub use bodies::BodyId;
 pub use emitters::EmitterId;
 pub use sinks::SinkId;
@@ -71,6 +73,9 @@ pub struct World {
     pub(crate) next_dt: f64,
     pub(crate) steps: u64,
     pub(crate) last: Option<StepStats>,
+    /// The GPU backend's stepper, while the world steps on the device ([`Backend::Gpu`]).
+    #[cfg(feature = "gpu")]
+    pub(crate) gpu: Option<Box<backend::GpuSlot>>,
 }
 
 impl World {
@@ -123,6 +128,8 @@ impl World {
             next_dt: params.dt_initial.clamp(params.dt_min, params.dt_max),
             steps: 0,
             last: None,
+            #[cfg(feature = "gpu")]
+            gpu: None,
             params,
         })
     }

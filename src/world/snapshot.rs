@@ -186,7 +186,7 @@ impl World {
 
     /// The Akinci masses ψ_b = ρ0·V_b (kg) of the static boundary particles at `points` (m),
     /// from their neighbours among them (docs/method.md §2.6), sorted into `grid`.
-    fn static_masses(
+    pub(super) fn static_masses(
         &self,
         grid: &UniformGrid,
         points: &[Vec3],

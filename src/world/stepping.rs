@@ -110,6 +110,11 @@ impl World {
     /// Errors ([`Error::OutOfMemory`]) when the step needs more memory than can be had,
     /// having changed nothing.
     fn take_prepared_step(&mut self, dt: f64) -> Result<&StepStats, Error> {
+        // A world without fluid (all removed) steps on the CPU, which only moves time on.
+        #[cfg(feature = "gpu")]
+        if self.gpu.is_some() && self.fluid_count() > 0 {
+            return self.take_gpu_step(dt);
+        }
         let oom = |_| Error::out_of_memory("the working storage of a time step");
         self.buffers
             .undo

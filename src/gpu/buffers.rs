@@ -1,0 +1,261 @@
+//! The particle state on the device, in single precision: the fluid's arrays in the order
+//! of the last sort, the static boundary sorted by cell once, the grid, the neighbour lists
+//! (CSR, grown as a step needs) and the iterates of the outer iteration; with the uniform
+//! constants the kernels read ([`StepParams`], [`IterParams`]).
+//!
+//! Positions on the device are relative to the grid's centre, so that single precision
+//! keeps its resolution wherever the scene lies.
+
+use super::context::Context;
+use crate::Vec3;
+use crate::boundary::Aabb;
+use bytemuck::{Pod, Zeroable};
+
+/// The most grid cells: a larger domain gets larger cells (still at least H, so the search
+/// stays correct, only slower).
+const MAX_CELLS: f64 = (1u64 << 24) as f64;
+/// Cells are this much wider than H, so that rounding never puts two particles within H
+/// of each other two cells apart.
+const CELL_SLACK: f64 = 1.0 + 1e-4;
+/// The neighbour lists are grown to this multiple of what a step needs.
+const LIST_GROWTH: f64 = 1.25;
+
+/// The step's constants as the shaders read them (`StepParams` in shaders/common.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(super) struct StepParams {
+    pub n: u32,
+    pub boundary_n: u32,
+    pub cells: u32,
+    /// 0 neighbour count, 1 unit, 2 uniform (docs/method.md §2.5).
+    pub weight_mode: u32,
+    pub dims: [u32; 4],
+    /// The grid's lowest corner (m, relative to its centre) and 1/cell size (1/m).
+    pub origin: [f32; 4],
+    /// g (m/s²) and Δt (s).
+    pub gravity: [f32; 4],
+    /// H (m), 1/H (1/m), σ (1/m³), 48/(πH⁴) (1/m⁴).
+    pub kernel: [f32; 4],
+    /// m (kg), ρ0 (kg/m³), Δt²k (kg), the membership floor.
+    pub mass: f32,
+    pub rest_density: f32,
+    pub dt2k: f32,
+    pub membership_floor: f32,
+    /// XSPH c_X, the rest stencil size c, the Newton step limit H/4 (m).
+    pub viscosity: f32,
+    pub rest_stencil: f32,
+    pub newton_limit: f32,
+    pub pad: f32,
+}
+
+/// One outer iteration's constants (`IterParams` in shaders/sweep.wgsl, finish.wgsl).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+pub(super) struct IterParams {
+    /// Chebyshev's ω and γ.
+    pub omega: f32,
+    pub gamma: f32,
+    /// 1 to extrapolate this iteration.
+    pub extrapolate: u32,
+    /// 1 when the last local step's densities are the result's.
+    pub densities_known: u32,
+}
+
+/// A uniform grid of cells at least H wide over a fixed box; particles outside it are
+/// counted in its edge cells (docs/method.md §6).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Grid {
+    /// Where device positions are measured from (m, world frame).
+    pub centre: Vec3,
+    /// The lowest corner relative to `centre` (m) in single precision, and 1/cell size.
+    pub origin: [f32; 3],
+    pub inverse_cell: f32,
+    pub dims: [u32; 3],
+}
+
+impl Grid {
+    /// A grid over `bounds` (m) padded by two support radii `h` (m) and a tenth of its
+    /// extent, with cells of H or, in a very large box, wider.
+    pub fn covering(bounds: Aabb, h: f64) -> Self {
+        let pad = Vec3::repeat(2.0 * h) + (bounds.max - bounds.min) * 0.1;
+        let (min, max) = (bounds.min - pad, bounds.max + pad);
+        let extent = max - min;
+        let mut cell = h * CELL_SLACK;
+        let count = |cell: f64| extent.map(|e| (e / cell).ceil().max(1.0));
+        let cells = count(cell);
+        let total = cells.x * cells.y * cells.z;
+        if total > MAX_CELLS {
+            cell *= (total / MAX_CELLS).cbrt() * CELL_SLACK;
+        }
+        let cells = count(cell);
+        let centre = (min + max) * 0.5;
+        let origin = min - centre;
+        Grid {
+            centre,
+            origin: [origin.x as f32, origin.y as f32, origin.z as f32],
+            inverse_cell: (1.0 / cell) as f32,
+            dims: [cells.x as u32, cells.y as u32, cells.z as u32],
+        }
+    }
+
+    /// The number of cells.
+    pub fn cells(&self) -> u32 {
+        self.dims[0] * self.dims[1] * self.dims[2]
+    }
+
+    /// A world position (m) as the device holds it.
+    pub fn device_position(&self, p: Vec3) -> [f32; 4] {
+        let r = p - self.centre;
+        [r.x as f32, r.y as f32, r.z as f32, 0.0]
+    }
+
+    /// A device position back in the world frame (m).
+    pub fn world_position(&self, p: [f32; 4]) -> Vec3 {
+        Vec3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2])) + self.centre
+    }
+
+    /// The cell of a device position, in the very arithmetic of `cell_coords` in
+    /// shaders/common.wgsl.
+    pub fn cell_of(&self, p: [f32; 4]) -> u32 {
+        let c: [u32; 3] = std::array::from_fn(|k| {
+            let top = self.dims[k] as f32 - 1.0;
+            let c = ((p[k] - self.origin[k]) * self.inverse_cell).floor();
+            c.clamp(0.0, top) as u32
+        });
+        c[0] + self.dims[0] * (c[1] + self.dims[1] * c[2])
+    }
+}
+
+/// Every buffer of the step on the device.
+pub(super) struct Buffers {
+    /// Fluid particles.
+    pub n: u32,
+    pub cells: u32,
+    /// x^n (m, relative), v (m/s), s (m) and each slot's particle (its index at upload).
+    pub x: wgpu::Buffer,
+    pub v: wgpu::Buffer,
+    pub s: wgpu::Buffer,
+    pub ids: wgpu::Buffer,
+    /// The permutation's targets, then the XSPH filter's velocities.
+    pub x_out: wgpu::Buffer,
+    pub v_out: wgpu::Buffer,
+    pub s_out: wgpu::Buffer,
+    pub ids_out: wgpu::Buffer,
+    /// The sort: each particle's cell, per cell its count and fill cursor, the order and
+    /// each cell's first slot (cells + 1).
+    pub cell_of: wgpu::Buffer,
+    pub counts: wgpu::Buffer,
+    pub cursor: wgpu::Buffer,
+    pub order: wgpu::Buffer,
+    pub cell_start: wgpu::Buffer,
+    /// Boundary particles sorted by cell (position and ψ (kg) in w) and each cell's first.
+    pub boundary: wgpu::Buffer,
+    pub boundary_start: wgpu::Buffer,
+    /// Neighbour counts, offsets (n + 1) and lists.
+    pub fluid_count: wgpu::Buffer,
+    pub boundary_count: wgpu::Buffer,
+    pub fluid_offset: wgpu::Buffer,
+    pub boundary_offset: wgpu::Buffer,
+    pub fluid_list: wgpu::Buffer,
+    pub boundary_list: wgpu::Buffer,
+    /// Kept corrections of multi-step projections: n + fluid list entries (m).
+    pub kept: wgpu::Buffer,
+    /// Entries the lists have room for.
+    pub fluid_room: u64,
+    pub boundary_room: u64,
+    /// X^(k) and X^(k−1), exchanging roles every outer iteration (m).
+    pub iterates: [wgpu::Buffer; 2],
+    /// The local step's own correction and λ, ρ_i (kg/m³) and multi-step flag.
+    pub projection: wgpu::Buffer,
+    pub density: wgpu::Buffer,
+    pub flags: wgpu::Buffer,
+    /// Per particle values to reduce (reduce.wgsl).
+    pub values: wgpu::Buffer,
+    pub params: wgpu::Buffer,
+    pub iter: wgpu::Buffer,
+}
+
+/// Bytes of a vec4<f32> and of a u32.
+const VEC4: u64 = 16;
+const WORD: u64 = 4;
+
+impl Buffers {
+    /// The buffers for `n` fluid particles and the sorted boundary `boundary` (device
+    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells.
+    pub fn new(
+        ctx: &Context,
+        n: u32,
+        cells: u32,
+        boundary: &[[f32; 4]],
+        boundary_start: &[u32],
+    ) -> Self {
+        let particles = u64::from(n);
+        let vec4 = |label| ctx.storage(label, particles * VEC4);
+        let word = |label, count: u64| ctx.storage(label, count * WORD);
+        let cell_words = u64::from(cells) + 1;
+        let fluid_room = particles * 40;
+        let boundary_room = particles * 16;
+        let buffers = Buffers {
+            n,
+            cells,
+            x: vec4("x"),
+            v: vec4("v"),
+            s: vec4("s"),
+            ids: word("ids", particles),
+            x_out: vec4("x_out"),
+            v_out: vec4("v_out"),
+            s_out: vec4("s_out"),
+            ids_out: word("ids_out", particles),
+            cell_of: word("cell_of", particles),
+            counts: word("counts", cell_words),
+            cursor: word("cursor", cell_words),
+            order: word("order", particles),
+            cell_start: word("cell_start", cell_words),
+            boundary: ctx.storage("boundary", boundary.len() as u64 * VEC4),
+            boundary_start: word("boundary_start", cell_words),
+            fluid_count: word("fluid_count", particles),
+            boundary_count: word("boundary_count", particles),
+            fluid_offset: word("fluid_offset", particles + 1),
+            boundary_offset: word("boundary_offset", particles + 1),
+            fluid_list: word("fluid_list", fluid_room),
+            boundary_list: word("boundary_list", boundary_room),
+            kept: ctx.storage("kept", (particles + fluid_room) * VEC4),
+            fluid_room,
+            boundary_room,
+            iterates: [vec4("iterate_a"), vec4("iterate_b")],
+            projection: vec4("projection"),
+            density: word("density", particles),
+            flags: word("flags", particles),
+            values: vec4("values"),
+            params: ctx.uniform("params", &StepParams::default()),
+            iter: ctx.uniform("iter", &IterParams::default()),
+        };
+        ctx.queue
+            .write_buffer(&buffers.boundary, 0, bytemuck::cast_slice(boundary));
+        ctx.queue.write_buffer(
+            &buffers.boundary_start,
+            0,
+            bytemuck::cast_slice(boundary_start),
+        );
+        buffers
+    }
+
+    /// Makes the lists room for `fluid` and `boundary` entries; true when they were
+    /// replaced (the bind groups that hold them must then be made again).
+    pub fn grow_lists(&mut self, ctx: &Context, fluid: u64, boundary: u64) -> bool {
+        let mut grown = false;
+        if fluid > self.fluid_room {
+            self.fluid_room = (fluid as f64 * LIST_GROWTH) as u64;
+            self.fluid_list = ctx.storage("fluid_list", self.fluid_room * WORD);
+            let slots = u64::from(self.n) + self.fluid_room;
+            self.kept = ctx.storage("kept", slots * VEC4);
+            grown = true;
+        }
+        if boundary > self.boundary_room {
+            self.boundary_room = (boundary as f64 * LIST_GROWTH) as u64;
+            self.boundary_list = ctx.storage("boundary_list", self.boundary_room * WORD);
+            grown = true;
+        }
+        grown
+    }
+}

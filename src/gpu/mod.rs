@@ -1,0 +1,46 @@
+//! The GPU backend (feature `gpu`): the time step of a world's fluid and static boundary
+//! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §1.3),
+//! in single precision. The fluid stays on the device during a step; a step reads back one
+//! reduction per outer iteration (the stopping rules, §4) and one at its end (statistics and
+//! the CFL rule, §8).
+//!
+//! Deterministic on one device and driver: integer atomics only where their result does not
+//! depend on the order (counting particles per cell; each cell's particles are then sorted
+//! by index), sums in a fixed tree, and every per-particle sum gathered by the particle
+//! itself in the order of its neighbour list.
+//!
+//! One file per stage: [`context`] (device, kernels, read-backs), [`buffers`] (the state on
+//! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists), [`local`]
+//! (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`] (the
+//! reductions of the stopping rules and statistics), [`finish`] (velocities, densities, XSPH,
+//! CFL) and [`stepper`] (the step in order). Shaders are in `shaders/`.
+
+/// A shader's WGSL source with shaders/common.wgsl (the step's constants, the kernel, the
+/// grid) before it.
+macro_rules! with_common {
+    ($path:literal) => {
+        concat!(
+            include_str!("shaders/common.wgsl"),
+            "\n",
+            include_str!($path)
+        )
+    };
+}
+
+mod buffers;
+mod context;
+mod finish;
+mod global;
+mod local;
+mod reduce;
+mod scan;
+mod search;
+mod stepper;
+
+pub(crate) use stepper::{GpuStepper, Scene};
+
+/// Opens the device once, to tell whether the GPU backend can run here; errors as
+/// [`context::Context::new`], naming what is missing.
+pub(crate) fn probe() -> Result<(), crate::Error> {
+    context::Context::new().map(|_| ())
+}

@@ -1,0 +1,418 @@
+//! [`GpuStepper`]: one time step of a world's fluid and static boundary on the device
+//! (docs/method.md §1.3), stage by stage as src/step/ takes it on the CPU: the neighbour
+//! phase (search.rs), the outer iteration of local steps (local.rs) and global steps with
+//! Chebyshev's extrapolation (global.rs) until a stopping rule holds (§4, read back once
+//! per outer iteration through reduce.rs), and the end of the step (finish.rs).
+//!
+//! Left out for now, as CPU-only extras that are off by default: the warm start (§4.1) and
+//! the coarse correction (§3.8); a GPU step always starts from s.
+
+use super::buffers::{Buffers, Grid, IterParams, StepParams};
+use super::context::{Context, floats, words};
+use super::finish::{Finish, next_step_size};
+use super::global::GlobalStep;
+use super::local::LocalStep;
+use super::reduce::Reduction;
+use super::search::Search;
+use crate::boundary::Aabb;
+use crate::params::{Params, ProjectionWeight, SolverKind};
+use crate::solver::Chebyshev;
+use crate::stats::{StepStats, StepTimings};
+use crate::{Error, Vec3};
+use std::time::Instant;
+
+/// The density rule also waits until the last outer iteration moved no particle farther
+/// than this multiple of τ (as src/step/iterate.rs).
+const DENSITY_RULE_MOTION: f64 = 10.0;
+
+/// What a [`GpuStepper`] is made from: a world's fluid and static boundary and its settings.
+#[derive(Clone, Copy)]
+pub(crate) struct Scene<'a> {
+    /// Fluid positions (m) and velocities (m/s).
+    pub positions: &'a [Vec3],
+    pub velocities: &'a [Vec3],
+    /// Static boundary particles (m) and their Akinci masses ψ (kg).
+    pub boundary: &'a [Vec3],
+    pub psi: &'a [f64],
+    pub params: &'a Params,
+    /// Fluid particle mass m (kg).
+    pub mass: f64,
+    /// The fewest stencils the global step counts a particle in (docs/method.md §3.1).
+    pub membership_floor: f64,
+}
+
+/// The fluid's state read back from the device, in the device's order.
+pub(crate) struct Readback {
+    /// Positions (m), velocities (m/s) and densities (kg/m³).
+    pub positions: Vec<Vec3>,
+    pub velocities: Vec<Vec3>,
+    pub densities: Vec<f64>,
+    /// The index, in the arrays last uploaded, of the particle in each slot.
+    pub order: Vec<u32>,
+}
+
+/// The fluid of a world on the device, stepped there.
+pub(crate) struct GpuStepper {
+    ctx: Context,
+    grid: Grid,
+    buffers: Buffers,
+    search: Search,
+    local: LocalStep,
+    global: GlobalStep,
+    finish: Finish,
+    reduction: Reduction,
+    params: Params,
+    constants: StepParams,
+    chebyshev: Chebyshev,
+    /// δ_k of the outer iterations of the current step (m).
+    displacements: Vec<f64>,
+}
+
+impl GpuStepper {
+    /// Opens the device and uploads `scene`. Errors when there is no usable adapter, or when
+    /// the scene has more particles than the device's indices reach.
+    pub fn new(scene: Scene) -> Result<Self, Error> {
+        let too_many = |what: &str, count: usize| {
+            Error::invalid(what, count, "must be fewer than 2³² on the GPU backend")
+        };
+        let n = u32::try_from(scene.positions.len())
+            .map_err(|_| too_many("fluid particles", scene.positions.len()))?;
+        u32::try_from(scene.boundary.len())
+            .map_err(|_| too_many("boundary particles", scene.boundary.len()))?;
+        let ctx = Context::new()?;
+        let params = scene.params.clone();
+        let h = params.support_radius();
+        let bounds = [Aabb::around(scene.positions), Aabb::around(scene.boundary)]
+            .into_iter()
+            .flatten()
+            .reduce(|a, b| a.union(&b))
+            .unwrap_or(Aabb {
+                min: Vec3::zeros(),
+                max: Vec3::zeros(),
+            });
+        let grid = Grid::covering(bounds, h);
+        let (boundary, boundary_start) = sort_boundary(&grid, scene.boundary, scene.psi);
+        let buffers = Buffers::new(&ctx, n, grid.cells(), &boundary, &boundary_start);
+        let constants = constants(&params, &grid, scene, boundary.len() as u32);
+        let reduction = Reduction::new(&ctx, n, &buffers.values);
+        let mut stepper = GpuStepper {
+            search: Search::new(&ctx),
+            local: LocalStep::new(&ctx),
+            global: GlobalStep::new(&ctx),
+            finish: Finish::new(&ctx),
+            reduction,
+            chebyshev: Chebyshev::new(params.chebyshev),
+            params,
+            constants,
+            grid,
+            displacements: Vec::new(),
+            buffers,
+            ctx,
+        };
+        stepper.bind();
+        stepper.upload(scene.positions, scene.velocities)?;
+        Ok(stepper)
+    }
+
+    /// The number of fluid particles.
+    pub fn len(&self) -> usize {
+        self.buffers.n as usize
+    }
+
+    fn bind(&mut self) {
+        let (ctx, b) = (&self.ctx, &self.buffers);
+        self.search.bind(ctx, b);
+        self.local.bind(ctx, b);
+        self.global.bind(ctx, b);
+        self.finish.bind(ctx, b);
+    }
+
+    /// Replaces the fluid's positions (m) and velocities (m/s), as many as the stepper has;
+    /// each slot's particle index restarts from its place in these arrays.
+    pub fn upload(&mut self, positions: &[Vec3], velocities: &[Vec3]) -> Result<(), Error> {
+        let b = &self.buffers;
+        let x: Vec<[f32; 4]> = positions
+            .iter()
+            .map(|&p| self.grid.device_position(p))
+            .collect();
+        let v: Vec<[f32; 4]> = velocities
+            .iter()
+            .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0])
+            .collect();
+        let ids: Vec<u32> = (0..b.n).collect();
+        self.ctx
+            .queue
+            .write_buffer(&b.x, 0, bytemuck::cast_slice(&x));
+        self.ctx
+            .queue
+            .write_buffer(&b.v, 0, bytemuck::cast_slice(&v));
+        self.ctx
+            .queue
+            .write_buffer(&b.ids, 0, bytemuck::cast_slice(&ids));
+        self.ctx.check()
+    }
+
+    /// Copies the fluid's state back from the device.
+    pub fn read(&self) -> Result<Readback, Error> {
+        let b = &self.buffers;
+        let n = u64::from(b.n);
+        let x = floats(&self.ctx.read(self.ctx.encoder(), &b.x, n * 16)?);
+        let v = floats(&self.ctx.read(self.ctx.encoder(), &b.v, n * 16)?);
+        let densities = floats(&self.ctx.read(self.ctx.encoder(), &b.density, n * 4)?);
+        let order = words(&self.ctx.read(self.ctx.encoder(), &b.ids, n * 4)?);
+        let grid = &self.grid;
+        Ok(Readback {
+            positions: x
+                .chunks_exact(4)
+                .map(|p| grid.world_position([p[0], p[1], p[2], p[3]]))
+                .collect(),
+            velocities: v
+                .chunks_exact(4)
+                .map(|v| Vec3::new(v[0].into(), v[1].into(), v[2].into()))
+                .collect(),
+            densities: densities.into_iter().map(f64::from).collect(),
+            order,
+        })
+    }
+
+    /// Advances the fluid by one step of `dt` seconds; returns what the step did and the
+    /// size of the next step by the CFL rule (s). Errors when the device fails; the
+    /// fluid's state on the device is then undefined.
+    pub fn step(&mut self, dt: f64) -> Result<(StepStats, f64), Error> {
+        let started = Instant::now();
+        let params = &self.params;
+        let mut constants = self.constants;
+        constants.gravity[3] = dt as f32;
+        constants.dt2k = (dt * dt * params.stiffness) as f32;
+        self.ctx
+            .queue
+            .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&constants));
+
+        let (fluid, boundary) = self.search.sort_and_count(&self.ctx, &self.buffers)?;
+        if self.buffers.grow_lists(&self.ctx, fluid, boundary) {
+            self.bind();
+        }
+        let mut encoder = self.ctx.encoder();
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.search.record_fill(&mut pass, &self.buffers);
+        }
+        self.start_from_prediction(&mut encoder);
+        self.ctx.queue.submit([encoder.finish()]);
+        let mut timings = StepTimings {
+            neighbors: started.elapsed().as_secs_f64(),
+            ..StepTimings::default()
+        };
+
+        let iterated = Instant::now();
+        let outcome = self.iterate()?;
+        timings.global = iterated.elapsed().as_secs_f64();
+
+        let finished = Instant::now();
+        let iter = IterParams {
+            densities_known: u32::from(outcome.densities_known),
+            ..IterParams::default()
+        };
+        let b = &self.buffers;
+        self.ctx
+            .queue
+            .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
+        let mut encoder = self.ctx.encoder();
+        self.finish.record(&mut encoder, b, outcome.result);
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.reduction.record(&mut pass);
+        }
+        let [error_sum, error_max, fastest, _] = self.reduction.read(&self.ctx, encoder)?;
+        timings.rest = finished.elapsed().as_secs_f64();
+        let stats = StepStats {
+            dt,
+            outer_iterations: outcome.outer,
+            inner_iterations: outcome.outer,
+            hit_max_iterations: !outcome.converged,
+            rho: outcome.rho,
+            last_displacement: outcome.displacement,
+            density_error_avg: f64::from(error_sum) / f64::from(b.n.max(1)),
+            density_error_max: f64::from(error_max),
+            timings,
+        };
+        Ok((stats, next_step_size(&self.params, f64::from(fastest))))
+    }
+
+    /// Records X^(0) = X^(−1) = s.
+    fn start_from_prediction(&self, encoder: &mut wgpu::CommandEncoder) {
+        let b = &self.buffers;
+        for iterate in &b.iterates {
+            encoder.copy_buffer_to_buffer(&b.s, 0, iterate, 0, u64::from(b.n) * 16);
+        }
+    }
+
+    /// The outer iteration (docs/method.md §1.3 step 4, §4), as src/step/iterate.rs: from
+    /// X^(0) = X^(−1) = s, a local step, the density rule, a global step with the
+    /// extrapolation and the displacement rule, until a rule holds or K_max; a step whose
+    /// extrapolation reaches K_max starts over from s without it. The local and global
+    /// steps of one outer iteration go to the device together and their reductions are
+    /// read back once.
+    fn iterate(&mut self) -> Result<Outcome, Error> {
+        let params = &self.params;
+        let n = f64::from(self.buffers.n.max(1));
+        self.chebyshev.reset();
+        self.displacements.clear();
+        let mut accelerate = params.solver == SolverKind::Chebyshev;
+        let rho = if accelerate {
+            self.chebyshev.rho()
+        } else {
+            0.0
+        };
+        let (mut outer, mut k, mut current) = (0, 0, 0);
+        let mut displacement = f64::INFINITY;
+        let (mut converged, mut densities_known) = (false, false);
+        let tolerance = params.displacement_tolerance;
+        loop {
+            if k == params.max_outer_iterations {
+                if !accelerate || params.min_outer_iterations >= params.max_outer_iterations {
+                    break;
+                }
+                // docs/method.md §4, "Fallback".
+                let mut encoder = self.ctx.encoder();
+                self.start_from_prediction(&mut encoder);
+                self.ctx.queue.submit([encoder.finish()]);
+                self.chebyshev.finish_step(&self.displacements);
+                (accelerate, k, current, displacement) = (false, 0, 0, f64::INFINITY);
+                self.displacements.clear();
+            }
+            let omega = if accelerate {
+                self.chebyshev.next_weight(k)
+            } else {
+                1.0
+            };
+            let iter = IterParams {
+                omega: omega as f32,
+                gamma: params.chebyshev.gamma as f32,
+                extrapolate: u32::from(accelerate && self.chebyshev.changes(omega)),
+                densities_known: 0,
+            };
+            let b = &self.buffers;
+            self.ctx
+                .queue
+                .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
+            let mut encoder = self.ctx.encoder();
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.local.record(&mut pass, b, current);
+                self.global.record(&mut pass, b, current);
+                self.reduction.record(&mut pass);
+            }
+            let [compression, moved, _, _] = self.reduction.read(&self.ctx, encoder)?;
+            // The density rule at X^(k), with the motion of the iteration before; the
+            // global step taken with it is then dropped.
+            if k >= params.min_outer_iterations
+                && displacement < DENSITY_RULE_MOTION * tolerance
+                && f64::from(compression) / n <= params.density_tolerance
+            {
+                (converged, densities_known) = (true, true);
+                break;
+            }
+            displacement = f64::from(moved);
+            self.displacements.push(displacement);
+            current = 1 - current;
+            outer += 1;
+            k += 1;
+            if k >= params.min_outer_iterations && displacement < tolerance {
+                converged = true;
+                break;
+            }
+        }
+        if accelerate {
+            self.chebyshev.finish_step(&self.displacements);
+        }
+        Ok(Outcome {
+            outer,
+            displacement,
+            rho,
+            converged,
+            densities_known,
+            result: current,
+        })
+    }
+}
+
+/// How the outer iteration ended.
+struct Outcome {
+    outer: usize,
+    /// Largest displacement of the last outer iteration (m).
+    displacement: f64,
+    /// ρ_c of the step (0 without extrapolation).
+    rho: f64,
+    converged: bool,
+    /// The last local step evaluated the densities at the result.
+    densities_known: bool,
+    /// The iterate buffer that holds the result.
+    result: usize,
+}
+
+/// The step's constants but Δt and Δt²k, which [`GpuStepper::step`] sets.
+fn constants(params: &Params, grid: &Grid, scene: Scene, boundary_n: u32) -> StepParams {
+    let h = params.support_radius();
+    let kernel = crate::kernel::CubicKernel::new(h);
+    let g = params.gravity;
+    StepParams {
+        n: scene.positions.len() as u32,
+        boundary_n,
+        cells: grid.cells(),
+        weight_mode: match params.projection_weight {
+            ProjectionWeight::NeighborCount => 0,
+            ProjectionWeight::Unit => 1,
+            ProjectionWeight::Uniform => 2,
+        },
+        dims: [grid.dims[0], grid.dims[1], grid.dims[2], 0],
+        origin: [
+            grid.origin[0],
+            grid.origin[1],
+            grid.origin[2],
+            grid.inverse_cell,
+        ],
+        gravity: [g[0] as f32, g[1] as f32, g[2] as f32, 0.0],
+        kernel: [
+            h as f32,
+            (1.0 / h) as f32,
+            kernel.w_zero() as f32,
+            (48.0 / (std::f64::consts::PI * h.powi(4))) as f32,
+        ],
+        mass: scene.mass as f32,
+        rest_density: params.rest_density as f32,
+        dt2k: 0.0,
+        membership_floor: scene.membership_floor as f32,
+        viscosity: params.viscosity as f32,
+        rest_stencil: params.rest_stencil_size() as f32,
+        newton_limit: (0.25 * h) as f32,
+        pad: 0.0,
+    }
+}
+
+/// The boundary particles at `points` (m) with masses `psi` (kg) in device form, sorted by
+/// the cell of `grid` they lie in (by index within a cell), and each cell's first slot
+/// (cells + 1 entries).
+fn sort_boundary(grid: &Grid, points: &[Vec3], psi: &[f64]) -> (Vec<[f32; 4]>, Vec<u32>) {
+    let device: Vec<[f32; 4]> = points
+        .iter()
+        .zip(psi)
+        .map(|(&p, &psi)| {
+            let mut d = grid.device_position(p);
+            d[3] = psi as f32;
+            d
+        })
+        .collect();
+    let cells: Vec<u32> = device.iter().map(|&p| grid.cell_of(p)).collect();
+    let mut order: Vec<u32> = (0..points.len() as u32).collect();
+    order.sort_by_key(|&k| cells[k as usize]);
+    let mut start = vec![0u32; grid.cells() as usize + 1];
+    for &c in &cells {
+        start[c as usize + 1] += 1;
+    }
+    for c in 0..grid.cells() as usize {
+        start[c + 1] += start[c];
+    }
+    let sorted = order.iter().map(|&k| device[k as usize]).collect();
+    (sorted, start)
+}

@@ -1,0 +1,193 @@
+//! Where a world's steps run: on the CPU (the default) or, in builds with the `gpu`
+//! feature, on a graphics card ([`Backend::Gpu`], src/gpu/). The GPU backend steps the
+//! fluid and the static boundary (container walls and obstacles as particles); a world with
+//! what it does not reach yet is refused with an error naming it.
+
+use super::World;
+use crate::Error;
+
+/// The hardware a world's time steps run on.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Backend {
+    /// The world's own thread pool, in double precision (the default).
+    #[default]
+    Cpu,
+    /// A graphics card through Vulkan compute shaders, in single precision (feature `gpu`).
+    /// Not yet with bodies, emitters, walls built as fields or the physical viscosity; the
+    /// solver is Chebyshev's or one Jacobi sweep. The warm start and the coarse correction
+    /// are left out on it (docs/method.md §4.1, §3.8).
+    Gpu,
+}
+
+impl Backend {
+    /// The backend's name, as `"cpu"` or `"gpu"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Cpu => "cpu",
+            Backend::Gpu => "gpu",
+        }
+    }
+}
+
+impl World {
+    /// The backend the world steps on.
+    pub fn backend(&self) -> Backend {
+        #[cfg(feature = "gpu")]
+        if self.gpu.is_some() {
+            return Backend::Gpu;
+        }
+        Backend::Cpu
+    }
+
+    /// Chooses where the world's steps run. [`Backend::Gpu`] opens the first Vulkan
+    /// adapter at once; the fluid is uploaded at the next step. Errors, changing nothing,
+    /// naming the backend and what is missing: a build without the `gpu` feature, no
+    /// Vulkan loader or adapter, or a world with what the GPU backend does not step yet.
+    pub fn set_backend(&mut self, backend: Backend) -> Result<(), Error> {
+        match backend {
+            Backend::Cpu => {
+                #[cfg(feature = "gpu")]
+                {
+                    self.gpu = None;
+                }
+                Ok(())
+            }
+            Backend::Gpu => self.open_gpu(),
+        }
+    }
+
+    #[cfg(not(feature = "gpu"))]
+    fn open_gpu(&mut self) -> Result<(), Error> {
+        Err(Error::invalid(
+            "backend",
+            "gpu",
+            "is not available: this build of projfluid has no `gpu` feature",
+        ))
+    }
+
+    #[cfg(feature = "gpu")]
+    fn open_gpu(&mut self) -> Result<(), Error> {
+        self.check_gpu_world()?;
+        if self.gpu.is_none() {
+            self.gpu = Some(Box::new(GpuSlot {
+                context: None,
+                boundary_len: usize::MAX,
+            }));
+            // The device is opened now, so that a missing adapter is reported here.
+            if let Err(e) = crate::gpu::probe() {
+                self.gpu = None;
+                return Err(e);
+            }
+        }
+        Ok(())
+    }
+
+    /// Errors, naming the feature, when the world holds what the GPU backend does not step.
+    #[cfg(feature = "gpu")]
+    fn check_gpu_world(&self) -> Result<(), Error> {
+        let refuse = |what: &str| {
+            Err(Error::invalid(
+                "backend",
+                "gpu",
+                &format!("does not support {what} yet; use the CPU backend"),
+            ))
+        };
+        use crate::params::SolverKind;
+        if !matches!(
+            self.params.solver,
+            SolverKind::Chebyshev | SolverKind::Jacobi1
+        ) {
+            return refuse(&format!("the {} solver", self.params.solver.name()));
+        }
+        if !self.bodies.is_empty() {
+            return refuse("bodies");
+        }
+        if !self.emitters.is_empty() {
+            return refuse("emitters");
+        }
+        if !self.boundary.walls.is_empty() {
+            return refuse("container walls built as fields");
+        }
+        if self.params.kinematic_viscosity > 0.0 {
+            return refuse("the physical viscosity (kinematic_viscosity)");
+        }
+        Ok(())
+    }
+
+    /// One step of `dt` seconds on the device, after [`World::prepare_steps`]: the fluid is
+    /// uploaded (the stepper made again where the particles changed in number), stepped and
+    /// read back, then sinks and the domain remove what left.
+    #[cfg(feature = "gpu")]
+    pub(super) fn take_gpu_step(&mut self, dt: f64) -> Result<&crate::stats::StepStats, Error> {
+        self.check_gpu_world()?;
+        let fluid_len = self.fluid.len();
+        let boundary_len = self.boundary.len();
+        let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
+        let stale = slot.boundary_len != boundary_len
+            || slot.context.as_ref().is_none_or(|s| s.len() != fluid_len);
+        if stale {
+            slot.context = None;
+            let (points, psi) = self.static_boundary()?;
+            let scene = crate::gpu::Scene {
+                positions: &self.fluid.positions,
+                velocities: &self.fluid.velocities,
+                boundary: &points,
+                psi: &psi,
+                params: &self.params,
+                mass: self.constraint.mass,
+                membership_floor: self.constraint.membership_floor,
+            };
+            let stepper = crate::gpu::GpuStepper::new(scene)?;
+            let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
+            slot.context = Some(stepper);
+            slot.boundary_len = boundary_len;
+        } else if let Some(stepper) = slot.context.as_mut() {
+            stepper.upload(&self.fluid.positions, &self.fluid.velocities)?;
+        }
+        let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
+        let stepper = slot.context.as_mut().expect("made above");
+        let (stats, next_dt) = stepper.step(dt)?;
+        let back = stepper.read()?;
+        let fluid = &mut self.fluid;
+        let ids: Vec<u64> = back.order.iter().map(|&k| fluid.ids[k as usize]).collect();
+        fluid.ids = ids;
+        fluid.positions = back.positions;
+        fluid.velocities = back.velocities;
+        fluid.densities = back.densities;
+        fluid.supports.clear();
+        self.next_dt = next_dt;
+        self.time += dt;
+        self.steps += 1;
+        self.drain();
+        Ok(self.last.insert(stats))
+    }
+
+    /// The static boundary particles (m) with their Akinci masses ψ (kg), computed here
+    /// where no CPU step has yet.
+    #[cfg(feature = "gpu")]
+    fn static_boundary(&self) -> Result<(Vec<crate::Vec3>, Vec<f64>), Error> {
+        let points = self.boundary.positions.to_vec();
+        if !self.boundary.dirty && self.boundary.psi.len() == points.len() {
+            return Ok((points, self.boundary.psi.clone()));
+        }
+        let Some(bounds) = crate::boundary::Aabb::around(&points) else {
+            return Ok((points, Vec::new()));
+        };
+        let h = self.params.support_radius();
+        let pad = crate::Vec3::repeat(2.0 * h);
+        let oom = |_| Error::out_of_memory("the boundary's masses");
+        let grid = crate::neighbors::UniformGrid::covering(bounds.min - pad, bounds.max + pad, h)
+            .map_err(oom)?;
+        let psi = self.static_masses(&grid, &points).map_err(oom)?;
+        Ok((points, psi))
+    }
+}
+
+/// The GPU backend's state in a world: the stepper, made at the first step and again when
+/// the particles change in number.
+#[cfg(feature = "gpu")]
+pub(crate) struct GpuSlot {
+    context: Option<crate::gpu::GpuStepper>,
+    /// Boundary particles the stepper was made with.
+    boundary_len: usize,
+}

@@ -245,3 +245,50 @@ fn unsupported_worlds_are_refused_naming_the_feature() {
     );
     assert_eq!(world.backend(), Backend::Cpu);
 }
+
+/// Set for the run of [`missing_adapter_probe`] that
+/// [`a_missing_adapter_is_refused_naming_what_is_missing`] starts.
+const PROBE: &str = "PROJFLUID_GPU_TEST_NO_ADAPTER";
+
+/// Without a Vulkan driver the GPU backend is refused with an error that names the backend
+/// and what is missing, and the world stays on the CPU. Runs this test binary again with the
+/// Vulkan loader pointed at no driver.
+#[test]
+fn a_missing_adapter_is_refused_naming_what_is_missing() {
+    let exe = std::env::current_exe().expect("the test binary");
+    let output = std::process::Command::new(exe)
+        .args(["--exact", "missing_adapter_probe", "--include-ignored"])
+        .args(["--nocapture", "--test-threads", "1"])
+        .env(PROBE, "1")
+        .env("VK_ICD_FILENAMES", "/nonexistent/icd.json")
+        .env("VK_DRIVER_FILES", "/nonexistent/icd.json")
+        .output()
+        .expect("the probe runs");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(
+        output.status.success() && stdout.contains("1 passed"),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&output.stderr)
+    );
+}
+
+/// The probe of [`a_missing_adapter_is_refused_naming_what_is_missing`]; passes trivially
+/// when run by itself.
+#[test]
+#[ignore = "run by a_missing_adapter_is_refused_naming_what_is_missing"]
+fn missing_adapter_probe() {
+    if std::env::var_os(PROBE).is_none() {
+        return;
+    }
+    let mut world = World::new(Params::default()).expect("parameters");
+    world
+        .add_fluid_block(Vec3::zeros(), [2, 2, 2], Vec3::zeros())
+        .expect("fluid");
+    let message = world.set_backend(Backend::Gpu).unwrap_err().to_string();
+    assert!(
+        message.contains("backend gpu") && message.contains("no Vulkan adapter"),
+        "{message}"
+    );
+    assert_eq!(world.backend(), Backend::Cpu);
+    world.step().expect("the CPU still steps");
+}

@@ -4,6 +4,7 @@
 //! [`Context::check`], never panicked on.
 
 use crate::Error;
+use crate::world::gpu_error;
 use std::sync::{Arc, Mutex};
 use std::task::{Context as TaskContext, Poll, Wake, Waker};
 
@@ -39,8 +40,8 @@ pub(super) struct Kernel {
 
 /// The error for a GPU backend that cannot run here: it names the backend and what is
 /// missing.
-pub(crate) fn unavailable(missing: &str) -> Error {
-    Error::invalid("backend", "gpu", &format!("cannot run: {missing}"))
+fn unavailable(missing: &str) -> Error {
+    gpu_error(&format!("cannot run: {missing}"))
 }
 
 impl Context {
@@ -121,11 +122,10 @@ impl Context {
                     self.adapter
                 )))
             }
-            Some(message) => Err(Error::invalid(
-                "backend",
-                "gpu",
-                &format!("failed on the device {}: {message}", self.adapter),
-            )),
+            Some(message) => Err(gpu_error(&format!(
+                "failed on the device {}: {message}",
+                self.adapter
+            ))),
         }
     }
 
@@ -232,13 +232,7 @@ impl Context {
         self.device
             .poll(wgpu::PollType::wait_indefinitely())
             .map(|_| ())
-            .map_err(|e| {
-                Error::invalid(
-                    "backend",
-                    "gpu",
-                    &format!("the device {} failed: {e}", self.adapter),
-                )
-            })
+            .map_err(|e| gpu_error(&format!("the device {} failed: {e}", self.adapter)))
     }
 
     /// A command encoder.
@@ -277,21 +271,15 @@ impl Context {
         match result {
             Some(Ok(())) => {}
             other => {
-                return Err(Error::invalid(
-                    "backend",
-                    "gpu",
-                    &format!(
-                        "could not read back from the device {}: {other:?}",
-                        self.adapter
-                    ),
-                ));
+                return Err(gpu_error(&format!(
+                    "could not read back from the device {}: {other:?}",
+                    self.adapter
+                )));
             }
         }
         let bytes = staging
             .get_mapped_range(..)
-            .map_err(|e| {
-                Error::invalid("backend", "gpu", &format!("could not map a read-back: {e}"))
-            })?
+            .map_err(|e| gpu_error(&format!("could not map a read-back: {e}")))?
             .to_vec();
         staging.unmap();
         Ok(bytes[..bytes.len().min(size as usize)].to_vec())

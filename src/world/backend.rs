@@ -29,6 +29,15 @@ impl Backend {
     }
 }
 
+/// An error of the GPU backend, [`Error::InvalidArgument`] for the field `backend`, its
+/// message `backend gpu: ` and what went wrong or is missing.
+pub(crate) fn gpu_error(what: &str) -> Error {
+    Error::InvalidArgument {
+        field: "backend".into(),
+        message: format!("backend gpu: {what}"),
+    }
+}
+
 impl World {
     /// The backend the world steps on.
     pub fn backend(&self) -> Backend {
@@ -58,10 +67,8 @@ impl World {
 
     #[cfg(not(feature = "gpu"))]
     fn open_gpu(&mut self) -> Result<(), Error> {
-        Err(Error::invalid(
-            "backend",
-            "gpu",
-            "is not available: this build of projfluid has no `gpu` feature",
+        Err(gpu_error(
+            "not available: this build of projfluid has no `gpu` feature",
         ))
     }
 
@@ -86,11 +93,9 @@ impl World {
     #[cfg(feature = "gpu")]
     fn check_gpu_world(&self) -> Result<(), Error> {
         let refuse = |what: &str| {
-            Err(Error::invalid(
-                "backend",
-                "gpu",
-                &format!("does not support {what} yet; use the CPU backend"),
-            ))
+            Err(gpu_error(&format!(
+                "does not support {what} yet; use the CPU backend"
+            )))
         };
         use crate::params::SolverKind;
         if !matches!(

@@ -19,6 +19,8 @@ mod stepping;
 mod tests;
 
 pub use backend::Backend;
+#[cfg(feature = "gpu")]
+pub(crate) use backend::gpu_error;
 pub use bodies::BodyId;
 pub use emitters::EmitterId;
 pub use sinks::SinkId;

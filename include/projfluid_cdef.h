@@ -22,7 +22,7 @@
  * Version of the binary interface these declarations describe; compare it with
  * pf_abi_version() at run time to detect a declarations/library mismatch.
  */
-enum { PF_ABI_VERSION = 3 };
+enum { PF_ABI_VERSION = 4 };
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -188,6 +188,8 @@ typedef struct PfTransform {
  * Every setting of a world (SI units: metres, seconds, kilograms). Fill it with
  * `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
  * validates it. The struct is plain data owned by the caller; the library copies it.
+ * Fields added in later versions are appended at its end (`kinematic_viscosity` and
+ * `no_slip` in ABI version 4), and each addition raises `PF_ABI_VERSION`.
  */
 typedef struct PfParams {
     /**
@@ -304,6 +306,19 @@ typedef struct PfParams {
      * Default 0.
      */
     uint32_t threads;
+    /**
+     * Kinematic viscosity ν (m²/s) of the implicit physical viscosity solve, finite and
+     * ≥ 0 (0 = off): water is 1e-6, olive oil about 1e-4, honey 1e-2 and more. Stable at
+     * every value and step size. Independent of the XSPH `viscosity`. Default 0.
+     */
+    double kinematic_viscosity;
+    /**
+     * 1: under the physical viscosity the walls, static obstacles and static bodies hold the
+     * fluid with no slip; 0: it slides along them (free slip). Moving bodies and walls built
+     * as fields let it slide either way; no effect while `kinematic_viscosity` is 0.
+     * Default 1.
+     */
+    uint32_t no_slip;
 } PfParams;
 
 /**

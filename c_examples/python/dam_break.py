@@ -46,6 +46,8 @@ class PfParams(ctypes.Structure):
         ("dt_initial", c_double),
         ("viscosity", c_double),
         ("threads", c_uint32),
+        ("kinematic_viscosity", c_double),
+        ("no_slip", c_uint32),
     ]
 
 

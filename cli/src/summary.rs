@@ -24,6 +24,11 @@ pub struct RunSummary {
     /// The coarse correction of each step's outer iteration was on (it is not used in worlds
     /// with bodies).
     pub coarse_correction: bool,
+    /// Kinematic viscosity ν of the physical viscosity solve (m²/s; 0 = off).
+    pub kinematic_viscosity: f64,
+    /// Walls, static obstacles and static bodies held the fluid with no slip under the
+    /// physical viscosity (false: free slip; no effect while `kinematic_viscosity` is 0).
+    pub no_slip: bool,
     /// Worker threads.
     pub threads: usize,
     /// Fluid particles.
@@ -161,6 +166,8 @@ impl RunAccumulator {
             eta: p.density_tolerance,
             tau: p.displacement_tolerance,
             coarse_correction: p.coarse_correction,
+            kinematic_viscosity: p.kinematic_viscosity,
+            no_slip: p.no_slip,
             threads: world.thread_count(),
             particles: world.fluid_count(),
             boundary_particles: world.boundary_count(),

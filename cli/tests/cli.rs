@@ -179,6 +179,8 @@ fn short_run_writes_stats_and_frames() {
         "rho",
         "tau",
         "coarse_correction",
+        "kinematic_viscosity",
+        "no_slip",
         "threads",
         "particles",
         "boundary_particles",
@@ -202,6 +204,8 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(json["steps"], 3);
     assert_eq!(json["threads"], 2);
     assert_eq!(json["coarse_correction"], false);
+    assert_eq!(json["kinematic_viscosity"], 0.0);
+    assert_eq!(json["no_slip"], true);
     assert_eq!(json["nan"], 0);
 
     let mut names: Vec<String> = std::fs::read_dir(&frames)
@@ -610,6 +614,84 @@ fn coarse_correction_is_switched_on_or_off() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `--kinematic-viscosity` and `--no-slip` replace the scene's `kinematic_viscosity` and
+/// `no_slip`, which the summary and the stats report and the run feels (no-slip walls under a
+/// viscosity give another final state than free-slip ones or none); a negative, not-a-number or non-numeric viscosity and a switch other
+/// than `on` or `off` are refused naming the option, before any stats are written.
+#[test]
+fn kinematic_viscosity_and_no_slip_reach_the_run() {
+    let dir = temp_dir("kinematic-viscosity");
+    let stats = dir.join("stats.json");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "dam_break_small",
+            "--steps",
+            "3",
+            "--threads",
+            "1",
+            "--stats",
+            stats.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        projfluid(&args)
+    };
+    for (bad, parts) in [
+        (
+            ["--kinematic-viscosity", "-0.001"],
+            &[
+                "--kinematic-viscosity must be finite and not negative",
+                "-0.001",
+            ][..],
+        ),
+        (
+            ["--kinematic-viscosity", "nan"],
+            &[
+                "--kinematic-viscosity must be finite and not negative",
+                "NaN",
+            ],
+        ),
+        (
+            ["--kinematic-viscosity", "honey"],
+            &["--kinematic-viscosity", "honey"],
+        ),
+        (["--no-slip", "2"], &["--no-slip", "'2'", "on", "off"]),
+    ] {
+        assert_bad_input(&run(&bad), parts);
+        assert!(!stats.exists(), "a refused run wrote {}", stats.display());
+    }
+    let stats_of = |out: &Output, summary: &str| {
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains(summary), "{stdout}");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        assert_eq!((&json["steps"], &json["nan"]), (&3.into(), &0.into()));
+        json
+    };
+    let water = stats_of(&run(&[]), "kinematic viscosity    off (no-slip walls)");
+    let honey = stats_of(
+        &run(&["--kinematic-viscosity", "0.01", "--no-slip", "off"]),
+        "kinematic viscosity    1.000e-2 m²/s, free-slip walls",
+    );
+    assert_eq!(honey["kinematic_viscosity"], 0.01, "{honey}");
+    assert_eq!(honey["no_slip"], false, "{honey}");
+    // The block's first steps are a uniform fall, which only walls that hold it can shear.
+    let held = stats_of(
+        &run(&["--kinematic-viscosity", "0.01", "--no-slip", "on"]),
+        "kinematic viscosity    1.000e-2 m²/s, no-slip walls",
+    );
+    assert_eq!(held["no_slip"], true, "{held}");
+    assert_ne!(held["positions_hash"], water["positions_hash"]);
+    assert_ne!(held["positions_hash"], honey["positions_hash"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// `--rho auto` estimates ρ_c online: the summary and the stats say so and report the mean
 /// estimate, which lies in the clamped range rather than at the starting value. Options given
 /// with it reach the world (`--threads 1` on any machine).
@@ -782,8 +864,20 @@ fn bench_flags_artifacts_of_a_far_too_loose_tolerance() {
 
 #[test]
 fn bench_and_tune_rho_reject_bad_options_with_exit_2() {
-    let cases: [(&[&str], &[&str]); 9] = [
+    let cases: [(&[&str], &[&str]); 11] = [
         (&["bench", "--steps", "0"], &["--steps", "0"]),
+        (
+            &["bench", "--kinematic-viscosity", "-1"],
+            &[
+                "--kinematic-viscosity",
+                "must be finite and not negative",
+                "-1",
+            ],
+        ),
+        (
+            &["bench", "--no-slip", "yes"],
+            &["--no-slip", "yes", "on", "off"],
+        ),
         (&["bench", "--scenes", "dam_break_small,nope"], &["nope"]),
         (&["bench", "--solvers", "cg,sor"], &["--solvers", "sor"]),
         (&["bench", "--rho", "1.5"], &["--rho", "1.5"]),

@@ -156,6 +156,52 @@ def test_the_coarse_correction_is_a_switch_a_world_reports_back() -> None:
         assert stats.nan_count == 0 and stats.escaped_count == 0
 
 
+def test_the_physical_viscosity_and_its_wall_condition_reach_the_world() -> None:
+    defaults = projfluid.Params()
+    assert defaults.kinematic_viscosity == 0.0 and defaults.no_slip is True
+    honey = small_params(kinematic_viscosity=1e-2, no_slip=False)
+    c = honey.to_c()
+    assert c.kinematic_viscosity == 1e-2 and c.no_slip == 0
+    assert small_params(no_slip=1).to_c().no_slip == 1
+    assert projfluid.Params.from_c(c) == honey
+    calm = honey.calm()
+    assert calm.kinematic_viscosity == 1e-2 and calm.no_slip is False
+    with projfluid.World(honey) as world:
+        assert world.params.kinematic_viscosity == 1e-2 and world.params.no_slip is False
+        assert world.params == honey
+    for bad in (-1e-6, math.nan, math.inf):
+        with pytest.raises(projfluid.InvalidArgumentError) as caught:
+            small_params(kinematic_viscosity=bad)
+        assert caught.value.message.startswith(
+            "pf_params_validate: params->kinematic_viscosity must be finite and not negative"
+        ), caught.value.message
+    with pytest.raises(ValueError, match="kinematic_viscosity must be a number"):
+        small_params(kinematic_viscosity="honey")
+
+
+def _sliding_speed(**settings: object) -> float:
+    """Mean x velocity (m/s) of a block sliding at 0.2 m/s along the floor of a tank without
+    gravity or XSPH, after one step of 2 ms."""
+    params = small_params(gravity=(0, 0, 0), viscosity=0, **settings)
+    with projfluid.World(params) as world:
+        world.add_container_box((0, 0, 0), (0.5, 0.4, 0.3))
+        world.add_fluid_box((0.03, 0.03, 0.03), (6, 7, 5), velocity=(0.2, 0, 0))
+        stats = world.step(0.002)
+        assert stats.nan_count == 0
+        return float(world.velocities()[:, 0].mean())
+
+
+def test_no_slip_walls_hold_a_viscous_block_that_free_slip_walls_let_slide() -> None:
+    water = _sliding_speed()
+    free = _sliding_speed(kinematic_viscosity=0.5, no_slip=False)
+    held = _sliding_speed(kinematic_viscosity=0.5, no_slip=True)
+    # Without walls to hold it a uniform motion has no shear for the viscosity to act on.
+    assert free == pytest.approx(water, rel=1e-3) and water > 0.19
+    assert held < 0.8 * free, (held, free)
+    # no_slip is only a wall condition: without a viscosity it changes nothing.
+    assert _sliding_speed(no_slip=False) == water
+
+
 def test_steps_report_their_statistics(world: projfluid.World) -> None:
     assert world.last_step.step_count == 0
     first = world.step(0.002)

@@ -1,7 +1,7 @@
 //! Checkpoints written and resumed: bit-for-bit continuation (with ρ_c estimated online, with
-//! the warm start's supports, before the first step, with rigid bodies, and with emitters,
-//! sinks and removed particles), and refused damaged, truncated, foreign and earlier-format
-//! files.
+//! the warm start's supports, with the physical viscosity, before the first step, with rigid
+//! bodies, and with emitters, sinks and removed particles), and refused damaged, truncated,
+//! foreign and earlier-format files.
 
 use super::*;
 use crate::body::BodyState;
@@ -109,6 +109,31 @@ fn a_resumed_world_keeps_its_online_rho() {
         assert_eq!(w.chebyshev.online(), saved);
         w.chebyshev = crate::solver::Chebyshev::new(params);
     });
+}
+
+/// The physical viscosity and its wall condition travel with the checkpoint's scene: a
+/// resumed viscous run with free-slip walls keeps both and continues bit for bit.
+#[test]
+fn a_resumed_world_keeps_its_physical_viscosity() {
+    let mut scene = small_scene();
+    scene.params.kinematic_viscosity = 0.05;
+    scene.params.no_slip = false;
+    let mut reference = scene.build_world().unwrap();
+    for _ in 0..10 {
+        reference.step().unwrap();
+    }
+    let path = temp("viscous.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.params().kinematic_viscosity, 0.05);
+    assert!(!resumed.params().no_slip);
+    for _ in 0..10 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert!(resumed.velocities() == reference.velocities());
 }
 
 #[test]

@@ -51,6 +51,8 @@ struct SceneFile {
     solver: Option<SolverFile>,
     time: Option<TimeFile>,
     viscosity: Option<f64>,
+    kinematic_viscosity: Option<f64>,
+    no_slip: Option<bool>,
     threads: Option<usize>,
     duration: f64,
     output: Option<OutputFile>,
@@ -211,6 +213,8 @@ impl SceneFile {
         set(&mut p.stiffness, self.stiffness);
         p.gravity = self.gravity.unwrap_or(p.gravity);
         set(&mut p.viscosity, self.viscosity);
+        set(&mut p.kinematic_viscosity, self.kinematic_viscosity);
+        p.no_slip = self.no_slip.unwrap_or(p.no_slip);
         p.threads = self.threads.unwrap_or(p.threads);
         let s = self.solver.unwrap_or_default();
         p.solver = s.kind.unwrap_or(p.solver);
@@ -334,6 +338,8 @@ impl SceneFile {
                 dt_initial: Some(p.dt_initial),
             }),
             viscosity: Some(p.viscosity),
+            kinematic_viscosity: Some(p.kinematic_viscosity),
+            no_slip: Some(p.no_slip),
             threads: Some(p.threads),
             duration: scene.duration,
             output: Some(OutputFile {

@@ -56,6 +56,7 @@ int main(int argc, char **argv) {
     CHECK(params.solver == PF_SOLVER_CHEBYSHEV);
     CHECK(params.gravity[1] == -9.81);
     CHECK(params.coarse_correction == 0);
+    CHECK(params.kinematic_viscosity == 0.0 && params.no_slip == 1);
     params.threads = 2;
     OK(pf_params_validate(&params));
 
@@ -68,6 +69,8 @@ int main(int argc, char **argv) {
     CHECK(calm.chebyshev_rho == 0.99 && calm.chebyshev_gamma == 0.5);
     CHECK(calm.chebyshev_auto_rho == 0);
     CHECK(calm.coarse_correction == 0);
+    CHECK(calm.kinematic_viscosity == params.kinematic_viscosity);
+    CHECK(calm.no_slip == params.no_slip);
     CHECK(calm.threads == 2 && calm.solver == params.solver);
     CHECK(calm.stiffness == params.stiffness && calm.dt_max == params.dt_max);
     OK(pf_params_validate(&calm));
@@ -90,6 +93,18 @@ int main(int argc, char **argv) {
     OK(pf_world_get_params(plain, &back));
     CHECK(back.coarse_correction == 1);
     pf_world_destroy(plain);
+
+    /* The physical viscosity and free-slip walls are kept by the world, and the calm settings
+       keep them. */
+    PfParams honey = params;
+    honey.kinematic_viscosity = 1e-2;
+    honey.no_slip = 0;
+    OK(pf_world_create(&honey, &plain));
+    OK(pf_world_get_params(plain, &back));
+    CHECK(back.kinematic_viscosity == 1e-2 && back.no_slip == 0);
+    pf_world_destroy(plain);
+    OK(pf_params_calm(&honey));
+    CHECK(honey.kinematic_viscosity == 1e-2 && honey.no_slip == 0);
 
     const float lo[3] = {-0.00625f, -0.00625f, -0.00625f};
     const float hi[3] = {0.40625f, 0.40625f, 0.30625f};

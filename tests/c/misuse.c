@@ -51,6 +51,8 @@ static void bad_params(PfParams p, const char *field) {
     CHECK(memcmp(&calm.chebyshev_gamma, &p.chebyshev_gamma, sizeof(double)) == 0);
     CHECK(calm.chebyshev_auto_rho == p.chebyshev_auto_rho);
     CHECK(calm.coarse_correction == p.coarse_correction);
+    CHECK(memcmp(&calm.kinematic_viscosity, &p.kinematic_viscosity, sizeof(double)) == 0);
+    CHECK(calm.no_slip == p.no_slip);
     rejected += 3;
 }
 
@@ -117,6 +119,18 @@ int main(void) {
     p = params;
     p.coarse_correction = 2;
     bad_params(p, "coarse_correction");
+    p = params;
+    p.kinematic_viscosity = NAN;
+    bad_params(p, "params->kinematic_viscosity must be finite and not negative");
+    p = params;
+    p.kinematic_viscosity = -1e-6;
+    bad_params(p, "params->kinematic_viscosity must be finite and not negative");
+    p = params;
+    p.kinematic_viscosity = INFINITY;
+    bad_params(p, "params->kinematic_viscosity must be finite and not negative");
+    p = params;
+    p.no_slip = 2;
+    bad_params(p, "params->no_slip must be 0 or 1, got 2");
 
     /* --- NULL pointers outside a world. --- */
     PfWorld *w = NULL;

@@ -50,7 +50,8 @@ fn every_key_is_read() {
                        "tau": 1e-6, "warm_start": 0.3, "coarse_correction": false,
                        "max_iterations": 50, "min_iterations": 2, "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
-            "viscosity": 0.02, "threads": 2, "duration": 3,
+            "viscosity": 0.02, "kinematic_viscosity": 1e-4, "no_slip": false,
+            "threads": 2, "duration": 3,
             "output": {"dir": "frames", "every": 5, "fps": 25}
         }"#;
     let s = Scene::from_json(text).unwrap();
@@ -80,6 +81,8 @@ fn every_key_is_read() {
         (0.4, 1e-5, 1e-2, 2e-3)
     );
     assert_eq!((p.viscosity, p.threads), (0.02, 2));
+    assert_eq!(p.kinematic_viscosity, 1e-4);
+    assert!(!p.no_slip);
     assert_eq!(s.containers[0].layers, 2);
     assert_eq!(
         s.containers[0].walls,
@@ -105,6 +108,8 @@ fn round_trip_through_json() {
     custom.params.projection_weight = crate::ProjectionWeight::Unit;
     custom.params.chebyshev.omega2_rule = crate::Omega2Rule::Paper;
     custom.params.coarse_correction = false;
+    custom.params.kinematic_viscosity = 1.0 / 3.0 * 1e-3;
+    custom.params.no_slip = false;
     custom.output.dir = Some(PathBuf::from("out [1]/frames"));
     custom.description = "quotes \" and [brackets]".to_string();
     scenes.push(custom);
@@ -223,6 +228,59 @@ fn coarse_correction_is_read_and_written() {
     assert_names(
         &message(Scene::from_json(&bad)),
         &["solver.coarse_correction"],
+    );
+}
+
+/// `kinematic_viscosity` (m²/s) is 0 and `no_slip` true unless a scene sets them; a scene
+/// written out keeps both; a value of the wrong type, a negative viscosity and one that is
+/// not a number are refused naming the key.
+#[test]
+fn kinematic_viscosity_and_no_slip_are_read_written_and_checked() {
+    let plain = Scene::from_json(GOOD).unwrap().params;
+    assert_eq!((plain.kinematic_viscosity, plain.no_slip), (0.0, true));
+    let honey = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"kinematic_viscosity\": 0.01, \"no_slip\": false, \"fluid_blocks\"",
+        1,
+    );
+    let scene = Scene::from_json(&honey).unwrap();
+    assert_eq!(scene.params.kinematic_viscosity, 0.01);
+    assert!(!scene.params.no_slip);
+    let json = scene.to_json();
+    assert!(json.contains("\"kinematic_viscosity\": 0.01"), "{json}");
+    assert!(json.contains("\"no_slip\": false"), "{json}");
+    let again = Scene::from_json(&json).unwrap();
+    assert_eq!(
+        (again.params.kinematic_viscosity, again.params.no_slip),
+        (0.01, false)
+    );
+    assert_eq!(again, scene);
+    // The default is written too, and read back as it was.
+    let json = Scene::from_json(GOOD).unwrap().to_json();
+    assert!(json.contains("\"kinematic_viscosity\": 0.0"), "{json}");
+    assert!(json.contains("\"no_slip\": true"), "{json}");
+    let bad = |extra: &str| {
+        let text = GOOD.replacen("\"fluid_blocks\"", &format!("{extra}, \"fluid_blocks\""), 1);
+        message(Scene::from_json(&text))
+    };
+    assert_names(&bad("\"no_slip\": 1"), &["no_slip", "a boolean"]);
+    assert_names(&bad("\"no_slip\": \"on\""), &["no_slip", "a boolean"]);
+    assert_names(
+        &bad("\"kinematic_viscosity\": \"honey\""),
+        &["kinematic_viscosity", "honey"],
+    );
+    // JSON has no NaN: the string is a wrong type, the bare word a syntax error.
+    assert_names(
+        &bad("\"kinematic_viscosity\": \"NaN\""),
+        &["kinematic_viscosity", "NaN"],
+    );
+    assert_names(
+        &bad("\"kinematic_viscosity\": NaN"),
+        &["line 5 column 32", "invalid JSON"],
+    );
+    assert_eq!(
+        bad("\"kinematic_viscosity\": -1e-6"),
+        "kinematic_viscosity must be finite and not negative (m²/s; 0 turns it off), got -0.000001"
     );
 }
 

@@ -64,6 +64,8 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         tau: args.tau,
         warm_start: None,
         coarse_correction: None,
+        kinematic_viscosity: None,
+        no_slip: None,
         threads: args.threads,
     };
     options.apply_checked(&mut scene)?;

@@ -29,6 +29,14 @@ pub(crate) struct ParamOptions {
     /// outer iterations (off by default; not used in worlds with bodies).
     #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
     pub(crate) coarse_correction: Option<bool>,
+    /// Kinematic viscosity ν of the implicit physical viscosity solve, in m²/s (0 turns it
+    /// off; water 1e-6, honey 1e-2).
+    #[arg(long, value_name = "NU", allow_negative_numbers = true)]
+    pub(crate) kinematic_viscosity: Option<f64>,
+    /// Whether walls, static obstacles and static bodies hold the fluid with no slip under the
+    /// physical viscosity (`on`, the default) or let it slide (`off`).
+    #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
+    pub(crate) no_slip: Option<bool>,
     /// Worker threads (0 = one per core).
     #[arg(long, value_name = "N")]
     pub(crate) threads: Option<usize>,
@@ -53,13 +61,19 @@ impl ParamOptions {
         if let Some(on) = self.coarse_correction {
             p.coarse_correction = on;
         }
+        if let Some(nu) = self.kinematic_viscosity {
+            p.kinematic_viscosity = nu;
+        }
+        if let Some(on) = self.no_slip {
+            p.no_slip = on;
+        }
         if let Some(threads) = self.threads {
             p.threads = threads;
         }
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 6] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 8] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
             ("solver.eta", "--eta", self.eta.is_some()),
@@ -74,6 +88,12 @@ impl ParamOptions {
                 "--coarse-correction",
                 self.coarse_correction.is_some(),
             ),
+            (
+                "kinematic_viscosity",
+                "--kinematic-viscosity",
+                self.kinematic_viscosity.is_some(),
+            ),
+            ("no_slip", "--no-slip", self.no_slip.is_some()),
             ("threads", "--threads", self.threads.is_some()),
         ]
     }

@@ -21,6 +21,14 @@ pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
                 s.tau
             )
         }),
+        ("kinematic viscosity", {
+            let walls = if s.no_slip { "no-slip" } else { "free-slip" };
+            if s.kinematic_viscosity > 0.0 {
+                format!("{:.3e} m²/s, {walls} walls", s.kinematic_viscosity)
+            } else {
+                format!("off ({walls} walls)")
+            }
+        }),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),
         ("boundary particles", s.boundary_particles.to_string()),

@@ -13,6 +13,7 @@ use crate::{EmitterShape, EmitterSpec, Vec3};
 pub(super) const NAMES: &[&str] = &[
     "dam_break_small",
     "fountain",
+    "honey_dam_break",
     "floating_boxes",
     "wave_tank",
     "dam_break_30k",
@@ -35,6 +36,18 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             [2.00625, 1.50625, 0.65625],
             1.0,
         )),
+        "honey_dam_break" => {
+            let mut scene = dam_break(
+                name,
+                "The dam_break_small block as honey: 16x20x12 particles of density 1420 kg/m³ and kinematic viscosity 0.01 m²/s, sticking to the walls (no slip), collapse slowly in a 2 x 1.5 x 0.65 m box. Walls r/4 outside the nominal box.",
+                [16, 20, 12],
+                [2.00625, 1.50625, 0.65625],
+                2.0,
+            );
+            scene.params.rest_density = 1420.0;
+            scene.params.kinematic_viscosity = 0.01;
+            Some(scene)
+        }
         "dam_break_30k" => Some(dam_break(
             name,
             "A 30x40x25 block of water (30,000 particles) collapses in a 5 x 3 x 1.3 m box. The walls sit r/4 = 0.00625 m outside the nominal box [0, L] so that no particle starts compressed in a three-wall corner.",

@@ -243,12 +243,7 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
     if let Some(d) = args.duration {
         setup.duration = d;
     }
-    setup.validate().map_err(|e| match e {
-        Error::InvalidArgument { field, message } => {
-            Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
-        }
-        other => input(other),
-    })?;
+    setup.validate().map_err(option_error)?;
     let data = Measurements::for_ratio(args.n2).map_err(runtime)?;
     create_dir(&args.common.out)?;
     let (a, d) = (
@@ -396,12 +391,7 @@ fn hydrostatic(args: &HydrostaticArgs) -> Result<(), Failure> {
             )));
         }
     };
-    setup.validate().map_err(|e| match e {
-        Error::InvalidArgument { field, message } => {
-            Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
-        }
-        other => input(other),
-    })?;
+    setup.validate().map_err(option_error)?;
     create_dir(&args.common.out)?;
     let report = hydrostatic::simulate(&setup, |_| {}).map_err(runtime)?;
     let files = hydrostatic::write_report(&args.common.out, &report).map_err(runtime)?;
@@ -430,12 +420,7 @@ fn poiseuille(args: &PoiseuilleArgs) -> Result<(), Failure> {
         threads: args.common.threads,
         ..poiseuille::Setup::default()
     };
-    setup.validate().map_err(|e| match e {
-        Error::InvalidArgument { field, message } => {
-            Failure::Input(message.replacen(&field, &format!("--{field}"), 1))
-        }
-        other => input(other),
-    })?;
+    setup.validate().map_err(option_error)?;
     create_dir(&args.common.out)?;
     let report = poiseuille::simulate(&setup, |_| {}).map_err(runtime)?;
     let files = poiseuille::write_report(&args.common.out, &report).map_err(runtime)?;

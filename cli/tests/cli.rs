@@ -1355,3 +1355,20 @@ fn a_run_says_how_many_block_particles_lay_inside_solids() {
     assert!(stderr.contains("cli_test: 27 particles, "), "{stderr}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// `--backend gpu` in the workspace's build, which leaves the GPU backend out, is refused
+/// (exit 2) naming the backend and the missing feature, before any step; `--backend` takes
+/// only `cpu` and `gpu`, and `--backend cpu` runs.
+#[test]
+fn the_gpu_backend_is_refused_where_the_build_lacks_it() {
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--backend", "gpu"]);
+    assert_bad_input(&out, &["backend gpu", "`gpu` feature"]);
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--backend", "tpu"]);
+    assert_eq!(out.status.code(), Some(2));
+    let out = projfluid(&["run", "dam_break_small", "--steps", "1", "--backend", "cpu"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}

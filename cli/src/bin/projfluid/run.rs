@@ -19,7 +19,7 @@ use print::print_summary;
 use progress::Progress;
 use projfluid::checkpoint::{RunEnd, read_checkpoint, write_checkpoint};
 use projfluid::scene::{Scene, load_probes};
-use projfluid::{Error, SolverKind};
+use projfluid::{Backend, Error, SolverKind};
 use projfluid_lab::driver::{self, RunError, RunLength};
 use projfluid_lab::validation::hydrostatic::READING_TOLERANCE_PER_RADIUS;
 use std::fs::File;
@@ -58,6 +58,11 @@ pub(crate) struct RunArgs {
     solver: Option<SolverKind>,
     #[command(flatten)]
     params: ParamOptions,
+    /// Where the steps run: `cpu`, or `gpu` (Vulkan; in a build with the `gpu` feature:
+    /// `cargo run --release --features gpu -- run …`). There is no fallback: a GPU that cannot
+    /// be had, or a scene it does not step yet, is an error naming what is missing.
+    #[arg(long, value_name = "cpu|gpu", default_value = "cpu", value_parser = ["cpu", "gpu"])]
+    backend: String,
     /// Write data frames (frame_00000.vtp, .vtk or .ply, …) into this directory, created if
     /// missing.
     #[arg(long, value_name = "DIR")]
@@ -110,6 +115,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
             .build_world()
             .map_err(|e| Failure::Input(e.to_string()))?,
     };
+    if args.backend == "gpu" {
+        world
+            .set_backend(Backend::Gpu)
+            .map_err(|e| Failure::Input(e.to_string()))?;
+    }
     if args.resume.is_some() && args.steps.is_none() && args.duration.is_none() {
         target = match saved_end {
             Some(RunEnd::Steps(n)) => RunLength::Steps(n.saturating_sub(world.steps())),

@@ -6,13 +6,14 @@
 //! masses) from the scene, so a body's mesh file must still be readable, and their poses,
 //! velocities and loads from the state.
 //!
-//! Layout: the magic `PFCHECK4`; the length (u64, little-endian) of a JSON header, the
+//! Layout: the magic `PFCHECK5`; the length (u64, little-endian) of a JSON header, the
 //! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
 //! containers (and which of them have walls that are fields), grid, counts, the run's end,
 //! the online ρ_c estimate, the bodies' poses, velocities and loads, the next particle id,
 //! the removed count, sinks, domain and emitters); the fluid positions, velocities,
 //! supports (docs/method.md §4.1; zeros while the warm start is off) and densities as f64
-//! triples/values, the particle ids as u64, the static boundary positions as f64 triples
+//! triples/values, the particle ids as u64, their materials as u16 (the header lists the
+//! materials, docs/method.md §14), the static boundary positions as f64 triples
 //! and their owners as u32 (all little-endian); and a SHA-256 digest of everything before
 //! it, so that a damaged or truncated file is refused.
 
@@ -25,12 +26,14 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK4";
+const MAGIC: &[u8; 8] = b"PFCHECK5";
 /// The magics of earlier formats, named in the errors that refuse them: before bodies,
-/// before particle ids, sinks and emitters, and before the warm start's supports.
+/// before particle ids, sinks and emitters, before the warm start's supports, and before
+/// materials.
 const MAGIC_V1: &[u8; 8] = b"PFCHECK1";
 const MAGIC_V2: &[u8; 8] = b"PFCHECK2";
 const MAGIC_V3: &[u8; 8] = b"PFCHECK3";
+const MAGIC_V4: &[u8; 8] = b"PFCHECK4";
 const DIGEST_LEN: usize = 32;
 
 /// Where the interrupted run was going to stop.
@@ -86,12 +89,17 @@ pub fn write_checkpoint(
         sinks: state.sinks.iter().map(saved_box).collect(),
         domain: state.domain.as_ref().map(saved_box),
         emitters: state.emitters.iter().map(SavedEmitter::of).collect(),
+        materials: (1..world.material_count())
+            .filter_map(|m| world.material(m as u16))
+            .map(|m| m.rest_density)
+            .collect(),
+        fluid_material: world.fluid_material(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
     let f = &state;
     let mut bytes = Vec::with_capacity(
-        64 + json.len() + f.positions.len() * 88 + f.boundary_positions.len() * 28,
+        64 + json.len() + f.positions.len() * 90 + f.boundary_positions.len() * 28,
     );
     bytes.extend_from_slice(MAGIC);
     bytes.extend_from_slice(&(json.len() as u64).to_le_bytes());
@@ -109,6 +117,9 @@ pub fn write_checkpoint(
     }
     for id in &f.ids {
         bytes.extend_from_slice(&id.to_le_bytes());
+    }
+    for m in &f.materials {
+        bytes.extend_from_slice(&m.to_le_bytes());
     }
     for p in &f.boundary_positions {
         push_vec3(&mut bytes, p);
@@ -162,6 +173,12 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
              this version cannot resume",
         ));
     }
+    if bytes.starts_with(MAGIC_V4) {
+        return Err(bad(
+            "is a checkpoint of an earlier version without fluid materials, which this \
+             version cannot resume",
+        ));
+    }
     if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
@@ -188,7 +205,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
     let (n, m) = (header.fluid_count, header.boundary_count);
     let expected = n
-        .checked_mul(3 * 8 * 3 + 8 + 8)
+        .checked_mul(3 * 8 * 3 + 8 + 8 + 2)
         .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
@@ -211,6 +228,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     }
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
     let ids: Vec<u64> = (0..n).map(|_| u64::from_le_bytes(data.take())).collect();
+    let materials: Vec<u16> = (0..n).map(|_| u16::from_le_bytes(data.take())).collect();
     let boundary = data.vec3s(m);
     let owners: Vec<u32> = (0..m).map(|_| u32::from_le_bytes(data.take())).collect();
     let bodies = header
@@ -227,6 +245,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         velocities,
         supports,
         densities,
+        materials,
         ids,
         next_id: header.next_id,
         removed_count: header.removed_count,
@@ -246,6 +265,14 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     // The bodies come from the scene (their meshes, samples and masses are not saved); the
     // particles of the walls, obstacles and fluid come from the state.
     let mut world = World::new(scene.params.clone())?;
+    for &rest_density in &header.materials {
+        world
+            .add_material(crate::Material { rest_density })
+            .map_err(|e| bad(&format!("holds an invalid material: {e}")))?;
+    }
+    world
+        .set_fluid_material(header.fluid_material)
+        .map_err(|e| bad(&format!("is inconsistent: {e}")))?;
     scene.add_bodies(&mut world).map_err(|e| {
         bad(&format!(
             "holds a scene whose bodies cannot be rebuilt: {e}"

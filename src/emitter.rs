@@ -46,6 +46,8 @@ pub struct EmitterState {
     pub travelled: f64,
     /// Particles emitted so far.
     pub emitted: u64,
+    /// The material of the particles it emits (docs/method.md §14).
+    pub material: crate::material::MaterialId,
 }
 
 /// Most lattice points an emitter layer may hold.
@@ -373,6 +375,7 @@ mod tests {
             },
             travelled: 0.1,
             emitted: 0,
+            material: 0,
         }
     }
 

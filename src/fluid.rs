@@ -2,6 +2,7 @@
 //! the particles' stable ids (docs/method.md §12.1).
 
 use crate::Vec3;
+use crate::material::MaterialId;
 
 /// Fluid particles in their current storage order (Z-order after the first step).
 #[derive(Clone, Debug, Default)]
@@ -17,6 +18,8 @@ pub(crate) struct Fluid {
     /// active constraint moved it; the next step starts from a share of it
     /// (docs/method.md §4.1). Empty while the warm start is off, else one per particle.
     pub supports: Vec<Vec3>,
+    /// Each particle's material (docs/method.md §14).
+    pub materials: Vec<MaterialId>,
     /// Each stored particle's id: given in the order particles were added, never reused.
     pub ids: Vec<u64>,
     /// The ids of the stored particles in ascending order, the order of every read.
@@ -33,15 +36,22 @@ impl Fluid {
         self.positions.len()
     }
 
-    /// Appends particles at `positions` (m) with `velocities` (m/s), the densities zero, and
-    /// gives them the next ids in order. The caller checked the lengths and values.
-    pub fn push(&mut self, positions: &[Vec3], velocities: impl IntoIterator<Item = Vec3>) {
-        self.extend(positions.iter().copied(), velocities);
+    /// Appends particles of `material` at `positions` (m) with `velocities` (m/s), the
+    /// densities zero, and gives them the next ids in order. The caller checked the lengths
+    /// and values.
+    pub fn push(
+        &mut self,
+        material: MaterialId,
+        positions: &[Vec3],
+        velocities: impl IntoIterator<Item = Vec3>,
+    ) {
+        self.extend(material, positions.iter().copied(), velocities);
     }
 
     /// [`Fluid::push`] from an iterator of positions (m), as many velocities (m/s) following.
     pub fn extend(
         &mut self,
+        material: MaterialId,
         positions: impl IntoIterator<Item = Vec3>,
         velocities: impl IntoIterator<Item = Vec3>,
     ) {
@@ -51,6 +61,7 @@ impl Fluid {
         let count = (self.positions.len() - before) as u64;
         self.velocities.extend(velocities);
         self.densities.resize(self.positions.len(), 0.0);
+        self.materials.resize(self.positions.len(), material);
         if !self.supports.is_empty() {
             self.supports.resize(self.positions.len(), Vec3::zeros());
         }
@@ -65,6 +76,7 @@ impl Fluid {
         self.positions.truncate(len);
         self.velocities.truncate(len);
         self.densities.truncate(len);
+        self.materials.truncate(len);
         self.supports.truncate(len);
         self.ids.truncate(len);
         self.ascending.truncate(len);
@@ -105,6 +117,7 @@ impl Fluid {
             self.positions[kept] = self.positions[i];
             self.velocities[kept] = self.velocities[i];
             self.densities[kept] = self.densities[i];
+            self.materials[kept] = self.materials[i];
             if let Some(&a) = self.supports.get(i) {
                 self.supports[kept] = a;
             }
@@ -117,6 +130,7 @@ impl Fluid {
         self.positions.truncate(kept);
         self.velocities.truncate(kept);
         self.densities.truncate(kept);
+        self.materials.truncate(kept);
         self.supports.truncate(kept);
         self.ids.truncate(kept);
         gone.sort_unstable();
@@ -137,7 +151,7 @@ mod tests {
         let mut fluid = Fluid::default();
         let at = |x: f64| Vec3::new(x, 0.0, 0.0);
         let points: Vec<Vec3> = (0..6).map(|i| at(i as f64)).collect();
-        fluid.push(&points, std::iter::repeat_n(Vec3::zeros(), 6));
+        fluid.push(0, &points, std::iter::repeat_n(Vec3::zeros(), 6));
         fluid.ids.reverse();
         fluid.positions.reverse();
         assert_eq!(fluid.rank(4), 4);
@@ -148,7 +162,7 @@ mod tests {
         assert_eq!(fluid.ascending, [0, 2, 3, 5]);
         assert_eq!((fluid.rank(5), fluid.rank(2)), (3, 1));
         assert!(fluid.holds(3) && !fluid.holds(4));
-        fluid.push(&[at(9.0)], [Vec3::zeros()]);
+        fluid.push(0, &[at(9.0)], [Vec3::zeros()]);
         assert_eq!(fluid.ids, [5, 3, 2, 0, 6]);
         assert_eq!((fluid.next_id, fluid.removed, fluid.rank(6)), (7, 2, 4));
         assert_eq!(fluid.remove_where(|_, _| false), 0);

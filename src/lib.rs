@@ -27,6 +27,7 @@ mod forces;
 mod gpu;
 pub mod io;
 pub mod kernel;
+pub mod material;
 pub mod neighbors;
 pub mod params;
 mod permutation;
@@ -44,6 +45,7 @@ mod world;
 
 pub use emitter::{Emitter, EmitterShape, EmitterSpec, EmitterState};
 pub use error::Error;
+pub use material::{Material, MaterialId};
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 pub use world::{Backend, BodyId, EmitterId, GridParts, SinkId, World, WorldState};
 

@@ -36,6 +36,10 @@ pub(super) struct Header {
     pub sinks: Vec<SavedBox>,
     pub domain: Option<SavedBox>,
     pub emitters: Vec<SavedEmitter>,
+    /// The rest densities (kg/m³) of the materials added to the world (docs/method.md §14),
+    /// in the order they were added, and the material of the fluid added next.
+    pub materials: Vec<f64>,
+    pub fluid_material: u16,
 }
 
 /// A box as its lower and upper corners (m).
@@ -118,6 +122,8 @@ pub(super) struct SavedEmitter {
     /// The last layer's travel (m).
     travelled: f64,
     emitted: u64,
+    /// The material it emits (docs/method.md §14).
+    material: u16,
 }
 
 /// An emitter's opening: a disc's radius or a rectangle's half-extents (m).
@@ -142,6 +148,7 @@ impl SavedEmitter {
             end_time: s.end_time,
             travelled: e.travelled,
             emitted: e.emitted,
+            material: e.material,
         }
     }
 
@@ -160,6 +167,7 @@ impl SavedEmitter {
             },
             travelled: self.travelled,
             emitted: self.emitted,
+            material: self.material,
         }
     }
 }

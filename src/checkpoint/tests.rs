@@ -136,6 +136,38 @@ fn a_resumed_world_keeps_its_physical_viscosity() {
     assert!(resumed.velocities() == reference.velocities());
 }
 
+/// Every particle's material and the world's materials travel with the checkpoint: a
+/// resumed world of two liquids continues bit for bit; one whose particles all forgot their
+/// material does not.
+#[test]
+fn a_resumed_world_keeps_its_materials() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let heavy = reference
+        .add_material(crate::Material {
+            rest_density: 2500.0,
+        })
+        .unwrap();
+    reference.set_fluid_material(heavy).unwrap();
+    reference
+        .add_fluid_block(Vec3::new(0.05, 0.5, 0.05), [3, 3, 3], Vec3::zeros())
+        .unwrap();
+    for _ in 0..5 {
+        reference.step().unwrap();
+    }
+    let path = temp("materials.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let resumed = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    assert_eq!(resumed.material_count(), 2);
+    assert_eq!(resumed.material(heavy), reference.material(heavy));
+    assert_eq!(resumed.fluid_material(), heavy);
+    assert_eq!(resumed.particle_materials(), reference.particle_materials());
+    resumed_matches_and_forgetful_does_not("materials", &scene, reference, 10, |w| {
+        w.fluid.materials.fill(0)
+    });
+}
+
 #[test]
 fn a_checkpoint_before_the_first_step_resumes_too() {
     let scene = small_scene();
@@ -247,6 +279,7 @@ fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
 fn checkpoints_of_earlier_formats_are_refused() {
     let path = temp("v2.pfck");
     for (magic, words) in [
+        (MAGIC_V4, "without fluid materials"),
         (MAGIC_V3, "warm start's supports"),
         (MAGIC_V2, "stable particle ids"),
         (MAGIC_V1, "without bodies"),

@@ -68,6 +68,7 @@ pub(super) fn check_flow(scene: &Scene) -> Result<(), Error> {
             spec: *spec,
             travelled: spacing,
             emitted: 0,
+            material: 0,
         };
         Emitter::new(state, spacing).map_err(|e| emitter_key(i, &spec.shape, e))?;
     }

@@ -243,18 +243,19 @@ impl Coupling {
     }
 
     /// The loads of the step that moved the fluid from the prediction `s` to `x` (m) with
-    /// step size `dt` (s), for particles of mass `mass` (kg): `out[o]` for body o, and
-    /// `out[bodies]` for the walls and obstacles, which take the rest of the momentum the
-    /// fluid exchanged in the step, K = −(m/Δt²) Σ_j (x_j − s_j), and of its moment.
+    /// step size `dt` (s), for particles of masses `masses` (kg, in the fluid's order):
+    /// `out[o]` for body o, and `out[bodies]` for the walls and obstacles, which take the
+    /// rest of the momentum the fluid exchanged in the step, K = −Σ_j (m_j/Δt²)(x_j − s_j),
+    /// and of its moment.
     pub(super) fn loads(
         &mut self,
-        mass: f64,
+        masses: &[f64],
         s: &Prediction,
         x: &[Vec3],
         dt: f64,
         out: &mut Vec<Load>,
     ) {
-        let scale = -mass / (dt * dt);
+        let dt2 = dt * dt;
         let bodies = self.bodies;
         let (particle, owner) = (&self.particle, &self.owner);
         // The room for the sums was made by `start` (and for `out` before the step).
@@ -267,8 +268,9 @@ impl Coupling {
             .enumerate()
             .for_each(|(block, (sums, shares))| {
                 for (slot, u) in (block * BLOCK..).zip(shares) {
-                    let force = u * scale;
-                    let arm = x[particle[slot] as usize];
+                    let i = particle[slot] as usize;
+                    let force = u * (-masses[i] / dt2);
+                    let arm = x[i];
                     sums[owner[slot] as usize].add(&Load {
                         force,
                         moment: arm.cross(&force),
@@ -284,7 +286,7 @@ impl Coupling {
             .enumerate()
             .for_each(|(block, (sum, xs))| {
                 for (j, xj) in (block * BLOCK..).zip(xs) {
-                    let force = (xj - s.at(j)) * scale;
+                    let force = (xj - s.at(j)) * (-masses[j] / dt2);
                     sum.add(&Load {
                         force,
                         moment: xj.cross(&force),

@@ -85,16 +85,16 @@ pub(super) fn iterate(
         warm,
         coarse,
     } = it;
-    // The system matrix of formulation F1, frozen for the step.
-    let mass = constraint.mass;
+    // The system matrix of formulation F1, frozen for the step, with every slot's mass.
     let dt2k = dt * dt * params.stiffness;
     let lists = &b.fluid_lists;
+    let masses = &b.masses;
     b.system.diagonal.resize(lists.len(), 0.0);
     b.system
         .diagonal
         .par_iter_mut()
         .enumerate()
-        .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
+        .for_each(|(j, a)| *a = masses[j] + dt2k * constraint.membership(lists, j));
     solver.prepare(&b.system)?;
 
     // The fluid holds one support per particle once a step with the warm start recorded
@@ -210,9 +210,9 @@ pub(super) fn iterate(
             });
         }
         let (projections, corrections) = (&b.projections, &b.corrections);
-        let current = &b.current;
+        let (current, masses) = (&b.current, &b.masses);
         let predicted = Prediction::new(fluid, Some(&b.order), dt, gravity);
-        // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
+        // b_j = m_j s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
         // for the particles of chunk `chunk`.
         let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {
             let first = chunk * CHUNK;
@@ -220,7 +220,7 @@ pub(super) fn iterate(
             for (j, rhs) in (first..).zip(rhs) {
                 let members = constraint.membership(lists, j);
                 let scale = constraint.correction_scale(lists, j);
-                *rhs = predicted.at(j) * mass + (current[j] * members + *rhs * scale) * dt2k;
+                *rhs = predicted.at(j) * masses[j] + (current[j] * members + *rhs * scale) * dt2k;
             }
         };
         if single_sweep {

@@ -74,6 +74,8 @@ pub(crate) struct StepBuffers {
     scratch_room: (usize, usize),
     /// The coarse correction's lattice, kept from step to step (docs/method.md §3.8).
     coarse: coarse::CoarseCorrection,
+    /// Every slot's mass m_i = ρ0_i·V (kg), from its material (docs/method.md §14).
+    masses: Vec<f64>,
 }
 
 /// Everything one time step reads and writes, borrowed from the world that owns it.
@@ -93,6 +95,8 @@ pub(crate) struct StepContext<'a> {
     pub containers: &'a [Aabb],
     /// The fluid's load on the walls and static obstacles (written).
     pub wall_load: &'a mut Load,
+    /// Each material's mass over the world's particle mass, ρ0_i/ρ0 (docs/method.md §14).
+    pub mass_ratios: &'a [f64],
     /// Simulated time at the start of the step (s).
     pub time: f64,
     /// The fastest emitter still emitting after the step (m/s; 0 without any), which the
@@ -122,6 +126,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
         bodies,
         containers,
         wall_load,
+        mass_ratios,
         time,
         inflow_speed,
     } = ctx;
@@ -141,6 +146,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             boundary.place_moving(grid, moving_particles(bodies))?;
         }
         search::search(grid, boundary, params.support_radius(), buffers)?;
+        slot_masses(constraint.mass, mass_ratios, &fluid.materials, buffers)?;
         reserve_scratch(pool, buffers)?;
         timings.neighbors = started.elapsed().as_secs_f64();
         if couple {
@@ -200,7 +206,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             let predicted = &search::Prediction::new(fluid, None, dt, gravity);
             buffers
                 .coupling
-                .loads(constraint.mass, predicted, &buffers.current, dt, loads);
+                .loads(&buffers.masses, predicted, &buffers.current, dt, loads);
             for (body, load) in bodies.iter_mut().zip(loads.iter()) {
                 body.force = load.force;
                 body.torque = load.torque_about(&body.centre_of_mass());
@@ -224,6 +230,24 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
     let speed = fastest_inflow(bodies, inflow_speed);
     let next_dt = pool.install(|| next_step_size(params, &fluid.velocities, gravity, dt, speed));
     Ok((stats, next_dt))
+}
+
+/// Every slot's mass (kg) in `b.masses`, in the sort's order: the world's particle mass
+/// `mass` (kg) times its material's entry of `ratios` (docs/method.md §14).
+fn slot_masses(
+    mass: f64,
+    ratios: &[f64],
+    materials: &[crate::material::MaterialId],
+    b: &mut StepBuffers,
+) -> Result<(), TryReserveError> {
+    crate::reserve::reserve_total(&mut b.masses, b.order.len())?;
+    b.masses.clear();
+    b.masses.extend(
+        b.order
+            .iter()
+            .map(|&o| mass * ratios[materials[o as usize] as usize]),
+    );
+    Ok(())
 }
 
 /// Makes every thread's buffers of the local step, the gather and the densities room for

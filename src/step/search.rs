@@ -273,7 +273,10 @@ pub(super) fn search(
 pub(super) fn permute_fluid(fluid: &mut Fluid, b: &mut StepBuffers) {
     permute(&b.order, &mut fluid.positions, &mut b.previous);
     permute(&b.order, &mut fluid.velocities, &mut b.previous);
-    permute_in_place(&mut b.order, |a, c| fluid.ids.swap(a, c));
+    permute_in_place(&mut b.order, |a, c| {
+        fluid.ids.swap(a, c);
+        fluid.materials.swap(a, c);
+    });
 }
 
 /// Reorders `data` so that slot k holds the old `data[order[k]]`.

@@ -116,6 +116,9 @@ impl World {
         if self.params.kinematic_viscosity > 0.0 {
             return refuse("the physical viscosity (kinematic_viscosity)");
         }
+        if !self.materials.single() {
+            return refuse("several fluid materials");
+        }
         Ok(())
     }
 

@@ -17,12 +17,14 @@ impl World {
     /// d, until its end time. Lattice points closer than 0.9·d to fluid are skipped. Returns
     /// the emitter's index. Errors, changing nothing, on a non-finite position, a zero or
     /// non-finite direction, a speed that is not positive and finite, a non-finite end time,
-    /// or an opening that holds no lattice point ("zero area") or far too many.
+    /// or an opening that holds no lattice point ("zero area") or far too many. It emits
+    /// fluid of the material [`World::set_fluid_material`] last chose.
     pub fn add_emitter(&mut self, spec: EmitterSpec) -> Result<EmitterId, Error> {
         let state = EmitterState {
             spec,
             travelled: self.params.spacing(),
             emitted: 0,
+            material: self.materials.current,
         };
         let emitter = Emitter::new(state, self.params.spacing())?;
         self.emitters.push(emitter);
@@ -101,11 +103,14 @@ impl World {
             // Against the fluid as it is, including the layers other emitters just inserted.
             emitter.mark_blocked(&offsets, &self.fluid.positions, &mut blocked);
             emitter.mark_solid(&offsets, |p| solids.contain(p), &mut blocked);
-            let velocity = emitter.velocity();
+            let (velocity, material) = (emitter.velocity(), emitter.state().material);
             points.clear();
             points.extend(emitter.free_points(&offsets, &blocked));
-            self.fluid
-                .push(&points, std::iter::repeat_n(velocity, points.len()));
+            self.fluid.push(
+                material,
+                &points,
+                std::iter::repeat_n(velocity, points.len()),
+            );
         }
         match solids.filter(|_| self.fluid.len() > first) {
             Some(solids) => self.settle_emitted(first, &solids),

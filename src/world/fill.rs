@@ -78,13 +78,14 @@ impl World {
         let first = self.fluid.next_id;
         let added = outside.iter().filter(|&&o| o).count();
         let at = (0..positions.len()).filter(kept).map(|k| positions[k]);
+        let material = self.materials.current;
         match velocities {
             Some(v) => self
                 .fluid
-                .extend(at, (0..v.len()).filter(kept).map(|k| v[k])),
+                .extend(material, at, (0..v.len()).filter(kept).map(|k| v[k])),
             None => self
                 .fluid
-                .extend(at, std::iter::repeat_n(Vec3::zeros(), added)),
+                .extend(material, at, std::iter::repeat_n(Vec3::zeros(), added)),
         }
         self.settle_new_fluid(first, solids, Settling::Clear);
         self.last_added = added;
@@ -138,8 +139,11 @@ impl World {
         let added = lattice(count, at).filter(|p| !solids.contain(p)).count();
         let first = self.fluid.next_id;
         let kept = lattice(count, at).filter(|p| !solids.contain(p));
-        self.fluid
-            .extend(kept, std::iter::repeat_n(velocity, added));
+        self.fluid.extend(
+            self.materials.current,
+            kept,
+            std::iter::repeat_n(velocity, added),
+        );
         self.settle_new_fluid(first, solids, Settling::Block);
         self.last_added = added;
         Ok(added)

@@ -9,6 +9,7 @@ mod backend;
 mod bodies;
 mod emitters;
 mod fill;
+mod materials;
 mod placement;
 mod read;
 mod sinks;
@@ -33,6 +34,7 @@ use crate::boundary::{Aabb, Boundary};
 use crate::constraint::{DensityConstraint, MEMBERSHIP_FLOOR};
 use crate::emitter::Emitter;
 use crate::fluid::Fluid;
+use crate::material::Materials;
 use crate::forces::{self, NonPressureForce};
 use crate::kernel::CubicKernel;
 use crate::params::{Params, SolverKind};
@@ -47,6 +49,8 @@ pub struct World {
     pub(crate) constraint: DensityConstraint,
     pub(crate) pool: rayon::ThreadPool,
     pub(crate) fluid: Fluid,
+    /// The fluid's materials (docs/method.md §14).
+    pub(crate) materials: Materials,
     pub(crate) boundary: Boundary,
     /// Container boxes; fluid outside all of them counts as escaped.
     pub(crate) containers: Vec<Aabb>,
@@ -112,6 +116,7 @@ impl World {
             },
             pool,
             fluid: Fluid::default(),
+            materials: Materials::default(),
             boundary: Boundary::default(),
             containers: Vec::new(),
             obstacles: Vec::new(),

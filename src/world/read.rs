@@ -59,10 +59,21 @@ impl World {
     /// Fluid densities (kg/m³) after the last step, in ascending id order (see
     /// [`World::ids`]); before a particle's first step, those evaluated when fluid was last
     /// added.
+    /// Each particle's density is its own material's: ρ0_i times the volume fraction its
+    /// neighbourhood fills (docs/method.md §14).
     pub fn densities(&self) -> Vec<f64> {
         let mut out = vec![0.0; self.fluid_count()];
-        self.gather_by_id(&self.fluid.densities, &mut out);
+        for (slot, &id) in self.fluid.ids.iter().enumerate() {
+            out[self.fluid.rank(id)] = self.material_density(slot);
+        }
         out
+    }
+
+    /// The density of the particle in storage slot `slot` in its material's terms (kg/m³):
+    /// the step keeps every density in the world's own fluid's terms.
+    pub(super) fn material_density(&self, slot: usize) -> f64 {
+        let ratio = self.materials.mass_ratios[self.fluid.materials[slot] as usize];
+        self.fluid.densities[slot] * ratio
     }
 
     /// Boundary particle positions (m), in the world's storage order: walls, obstacles and
@@ -82,19 +93,28 @@ impl World {
         points
     }
 
-    /// Kinetic energy Σ ½m|v|² (J).
+    /// Kinetic energy Σ ½m_i|v_i|² (J), each particle of its material's mass.
     pub fn kinetic_energy(&self) -> f64 {
-        let m = self.constraint.mass;
-        self.pool
-            .install(|| reduce::sum(&self.fluid.velocities, |v| 0.5 * m * v.norm_squared()))
+        let (m, fluid) = (self.constraint.mass, &self.fluid);
+        let ratios = &self.materials.mass_ratios;
+        self.pool.install(|| {
+            reduce::sum_over(fluid.len(), |i| {
+                let mi = m * ratios[fluid.materials[i] as usize];
+                0.5 * mi * fluid.velocities[i].norm_squared()
+            })
+        })
     }
 
-    /// Potential energy −Σ m g·x (J), zero at the origin.
+    /// Potential energy −Σ m_i g·x_i (J), zero at the origin.
     pub fn potential_energy(&self) -> f64 {
-        let m = self.constraint.mass;
+        let (m, fluid) = (self.constraint.mass, &self.fluid);
+        let ratios = &self.materials.mass_ratios;
         let g = Vec3::from(self.params.gravity);
-        self.pool
-            .install(|| reduce::sum(&self.fluid.positions, |x| -m * g.dot(x)))
+        self.pool.install(|| {
+            reduce::sum_over(fluid.len(), |i| {
+                -m * ratios[fluid.materials[i] as usize] * g.dot(&fluid.positions[i])
+            })
+        })
     }
 
     /// Root-mean-square speed of the fluid (m/s).
@@ -174,8 +194,8 @@ impl World {
     pub fn write_densities_f32(&self, out: &mut [f32]) -> Result<(), usize> {
         let n = self.fluid_count();
         let out = out.get_mut(..n).ok_or(n)?;
-        for (&rho, &id) in self.fluid.densities.iter().zip(&self.fluid.ids) {
-            out[self.fluid.rank(id)] = rho as f32;
+        for (slot, &id) in self.fluid.ids.iter().enumerate() {
+            out[self.fluid.rank(id)] = self.material_density(slot) as f32;
         }
         Ok(())
     }

@@ -37,6 +37,8 @@ pub struct WorldState {
     /// (m/s²), which the next step's warm start reads (docs/method.md §4.1): empty while the
     /// warm start is off.
     pub supports: Vec<Vec3>,
+    /// Each fluid particle's material (docs/method.md §14), one of the world's.
+    pub materials: Vec<crate::material::MaterialId>,
     /// Each stored fluid particle's id (docs/method.md §12.1): unique, below `next_id`.
     pub ids: Vec<u64>,
     /// The id the next added particle gets: the number of particles ever added.
@@ -97,6 +99,7 @@ impl World {
             velocities: fluid.velocities.clone(),
             densities: fluid.densities.clone(),
             supports: fluid.supports.clone(),
+            materials: fluid.materials.clone(),
             ids: fluid.ids.clone(),
             next_id: fluid.next_id,
             removed_count: fluid.removed,
@@ -133,6 +136,7 @@ impl World {
         for (name, len) in [
             ("velocities", state.velocities.len()),
             ("densities", state.densities.len()),
+            ("materials", state.materials.len()),
             ("ids", state.ids.len()),
         ] {
             if len != n {
@@ -153,6 +157,13 @@ impl World {
             ));
         }
         super::check_finite("state.supports", &state.supports)?;
+        let emitted = state.emitters.iter().map(|e| &e.material);
+        for (name, &m) in std::iter::repeat("state.materials")
+            .zip(&state.materials)
+            .chain(std::iter::repeat("state.emitters.material").zip(emitted))
+        {
+            self.materials.check_id(name, m)?;
+        }
         super::check_finite("state.boundary_positions", &state.boundary_positions)?;
         let ascending = checked_ids(&state)?;
         for (k, sink) in state.sinks.iter().enumerate() {
@@ -255,6 +266,7 @@ impl World {
         fluid.velocities = state.velocities;
         fluid.densities = state.densities;
         fluid.supports = state.supports;
+        fluid.materials = state.materials;
         fluid.ids = state.ids;
         fluid.ascending = ascending;
         fluid.next_id = state.next_id;

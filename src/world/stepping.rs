@@ -142,6 +142,7 @@ impl World {
             wall_load,
             time,
             containers,
+            materials,
             ..
         } = self;
         let context = StepContext {
@@ -158,6 +159,7 @@ impl World {
             bodies,
             containers,
             wall_load,
+            mass_ratios: &materials.mass_ratios,
             time: *time,
             inflow_speed,
         };

@@ -1,0 +1,134 @@
+//! Fluid materials: several liquids of different rest densities in one world
+//! (docs/method.md §14).
+//!
+//! Every fluid particle carries a material. All materials share the world's particle size,
+//! so every particle has the same rest volume V = m/ρ0 (the world's mass over the world's
+//! rest density). The density constraint is written on volumes, C_i = V·Σ_j W_ij + … − 1,
+//! which is the number-density form of multi-density SPH (Solenthaler and Pajarola 2008):
+//! a light particle beside heavy ones sums their volumes, not their masses, so an interface
+//! between two liquids is not read as compressed. A material's rest density enters the step
+//! through its particles' masses m_i = ρ0_i·V, that is through the inertia of the global step
+//! (M in M(x − s)/Δt² = Σ forces): a heavier particle is pushed less by the same constraint
+//! force and weighs more.
+//!
+//! Material 0 is the world's own fluid ([`crate::Params::rest_density`]); others are added
+//! with [`crate::World::add_material`].
+
+use crate::Error;
+
+/// The index of a material in its world: 0 is the world's own fluid, then the materials in
+/// the order [`crate::World::add_material`] added them.
+pub type MaterialId = u16;
+
+/// The most materials a world holds, its own fluid included.
+pub const MAX_MATERIALS: usize = 256;
+
+/// The lightest and heaviest rest density a material may have, as multiples of the world's
+/// rest density: beyond a factor of ten the global step's inertia differs so much between
+/// neighbours that the iteration no longer converges within its limits.
+pub const DENSITY_RATIO_RANGE: (f64, f64) = (0.1, 10.0);
+
+/// A liquid's physical properties.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Material {
+    /// Rest density ρ0 (kg/m³).
+    pub rest_density: f64,
+}
+
+impl Material {
+    /// Errors, naming the field, where the material cannot be simulated in a world of rest
+    /// density `reference` (kg/m³).
+    pub(crate) fn check(&self, reference: f64) -> Result<(), Error> {
+        let (low, high) = DENSITY_RATIO_RANGE;
+        let ratio = self.rest_density / reference;
+        if !(ratio.is_finite() && (low..=high).contains(&ratio)) {
+            return Err(Error::invalid(
+                "rest_density",
+                self.rest_density,
+                &format!(
+                    "must be between {} and {} kg/m³ ({low} to {high} times the world's rest density)",
+                    low * reference,
+                    high * reference
+                ),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// A world's materials beyond its own fluid, and the one that fluid added next is made of.
+#[derive(Clone, Debug)]
+pub(crate) struct Materials {
+    /// Materials 1, 2, … in the order they were added.
+    pub added: Vec<Material>,
+    /// Every material's mass over the world's particle mass, ρ0_i/ρ0 (dimensionless),
+    /// indexed by material: 1 for the world's own fluid.
+    pub mass_ratios: Vec<f64>,
+    /// The material of the fluid added next: blocks, particles, and the emitters added next.
+    pub current: MaterialId,
+}
+
+impl Default for Materials {
+    fn default() -> Self {
+        Self {
+            added: Vec::new(),
+            mass_ratios: vec![1.0],
+            current: 0,
+        }
+    }
+}
+
+impl Materials {
+    /// Number of materials, the world's own fluid included.
+    pub fn len(&self) -> usize {
+        self.added.len() + 1
+    }
+
+    /// Whether the world holds only its own fluid.
+    #[cfg(feature = "gpu")]
+    pub fn single(&self) -> bool {
+        self.added.is_empty()
+    }
+
+    /// Material `id`, the world's own fluid (of rest density `reference`, kg/m³) for 0.
+    pub fn get(&self, id: MaterialId, reference: f64) -> Option<Material> {
+        match id {
+            0 => Some(Material {
+                rest_density: reference,
+            }),
+            _ => self.added.get(id as usize - 1).copied(),
+        }
+    }
+
+    /// Adds `material` to a world of rest density `reference` (kg/m³) and returns its id.
+    /// Errors, changing nothing, on a material [`Material::check`] rejects or one too many.
+    pub fn add(&mut self, material: Material, reference: f64) -> Result<MaterialId, Error> {
+        material.check(reference)?;
+        if self.len() >= MAX_MATERIALS {
+            return Err(Error::invalid(
+                "material",
+                self.len(),
+                &format!("a world holds at most {MAX_MATERIALS} materials"),
+            ));
+        }
+        self.added.push(material);
+        self.mass_ratios.push(material.rest_density / reference);
+        Ok((self.len() - 1) as MaterialId)
+    }
+
+    /// Errors, naming `field`, where `id` is not one of the materials.
+    pub fn check_id(&self, field: &str, id: MaterialId) -> Result<(), Error> {
+        if (id as usize) < self.len() {
+            return Ok(());
+        }
+        Err(Error::invalid(
+            field,
+            id,
+            &format!(
+                "must name one of the world's {} materials (0 to {})",
+                self.len(),
+                self.len() - 1
+            ),
+        ))
+    }
+}

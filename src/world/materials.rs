@@ -1,0 +1,50 @@
+//! Materials in a world (docs/method.md §14): adding them, choosing the one that fluid added
+//! next is made of, and reading every particle's.
+
+use super::World;
+use crate::Error;
+use crate::material::{Material, MaterialId};
+
+impl World {
+    /// Adds a fluid material and returns its id (1 for the first added: 0 is the world's own
+    /// fluid, of [`crate::Params::rest_density`]). Fluid of it is added after
+    /// [`World::set_fluid_material`] chooses it. Errors, changing nothing, on a rest density
+    /// that is not finite or lies outside [`crate::material::DENSITY_RATIO_RANGE`] times the
+    /// world's, or on more than [`crate::material::MAX_MATERIALS`] materials.
+    pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
+        self.materials.add(material, self.params.rest_density)
+    }
+
+    /// Chooses the material of the fluid added from now on: by [`World::add_fluid_block`],
+    /// [`World::add_fluid_particles`] and the emitters added from now on
+    /// ([`World::add_emitter`]). Errors, changing nothing, on an id the world has no
+    /// material for.
+    pub fn set_fluid_material(&mut self, material: MaterialId) -> Result<(), Error> {
+        self.materials.check_id("material", material)?;
+        self.materials.current = material;
+        Ok(())
+    }
+
+    /// The material the fluid added next is made of (0, the world's own fluid, until
+    /// [`World::set_fluid_material`] chooses another).
+    pub fn fluid_material(&self) -> MaterialId {
+        self.materials.current
+    }
+
+    /// Material `id`, if the world has it.
+    pub fn material(&self, id: MaterialId) -> Option<Material> {
+        self.materials.get(id, self.params.rest_density)
+    }
+
+    /// Number of materials, the world's own fluid included.
+    pub fn material_count(&self) -> usize {
+        self.materials.len()
+    }
+
+    /// Every fluid particle's material, in ascending id order (see [`World::ids`]).
+    pub fn particle_materials(&self) -> Vec<MaterialId> {
+        let mut out = vec![0; self.fluid_count()];
+        self.gather_by_id(&self.fluid.materials, &mut out);
+        out
+    }
+}

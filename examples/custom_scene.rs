@@ -28,16 +28,19 @@ fn main() -> Result<(), projfluid::Error> {
         }],
         obstacles: Vec::new(),
         bodies: Vec::new(),
+        materials: Vec::new(),
         fluid_blocks: vec![
             FluidBlock {
                 start: [0.05, 0.05, 0.05],
                 count: [6, 10, 8],
                 velocity: [0.0; 3],
+                material: None,
             },
             FluidBlock {
                 start: [0.7, 0.4, 0.05],
                 count: [4, 4, 8],
                 velocity: [-1.0, 0.0, 0.0],
+                material: None,
             },
         ],
         emitters: Vec::new(),

@@ -23,6 +23,7 @@ pub use crate::boundary::ContainerWalls;
 pub use bodies::{BodyShape, MotionSpec, SceneBody};
 pub use spec::{
     BoxSpec, ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
+    SceneMaterial,
 };
 
 use crate::boundary::Aabb;
@@ -46,6 +47,9 @@ pub struct Scene {
     pub obstacles: Vec<ObstacleSpec>,
     /// Rigid bodies: static, kinematic or dynamic (may be empty). Body `i` gets id `i`.
     pub bodies: Vec<SceneBody>,
+    /// Liquids besides the world's own fluid (may be empty): material `i` here is the world's
+    /// material `i + 1` (docs/method.md §14).
+    pub materials: Vec<SceneMaterial>,
     /// Blocks of fluid (at least one).
     pub fluid_blocks: Vec<FluidBlock>,
     /// Emitters inserting fluid from the start of the first step (may be empty). Emitter `i`
@@ -185,13 +189,36 @@ impl Scene {
                 .map_err(|e| prefixed(e, &prefix))?;
         }
         self.add_bodies(world)?;
+        for (i, m) in self.materials.iter().enumerate() {
+            let material = crate::Material {
+                rest_density: m.rest_density,
+            };
+            world
+                .add_material(material)
+                .map_err(|e| prefixed(e, &format!("materials[{i}]: ")))?;
+        }
         for (i, b) in self.fluid_blocks.iter().enumerate() {
+            let prefix = format!("fluid_blocks[{i}]: ");
+            world
+                .set_fluid_material(self.material_id(b))
+                .map_err(|e| prefixed(e, &prefix))?;
             world
                 .add_fluid_block(Vec3::from(b.start), b.count, Vec3::from(b.velocity))
-                .map_err(|e| prefixed(e, &format!("fluid_blocks[{i}]: ")))?;
+                .map_err(|e| prefixed(e, &prefix))?;
         }
+        world.set_fluid_material(0)?;
         self.add_flow(world)?;
         Ok(())
+    }
+
+    /// The world's material id of `block`'s material: 0 for the world's own fluid (or a name
+    /// the scene lacks, which validation refuses), else one past its index in `materials`.
+    pub fn material_id(&self, block: &FluidBlock) -> crate::MaterialId {
+        block
+            .material
+            .as_ref()
+            .and_then(|name| self.materials.iter().position(|m| &m.name == name))
+            .map_or(0, |i| (i + 1) as crate::MaterialId)
     }
 
     /// The scene as pretty JSON with every key written out; [`Scene::from_json`] reads it back

@@ -2,7 +2,7 @@
 
 use super::{
     BodyShape, BoxSpec, ContainerSpec, ContainerWalls, FluidBlock, MeshSource, MotionSpec,
-    ObstacleSpec, OutputSpec, Scene, SceneBody,
+    ObstacleSpec, OutputSpec, Scene, SceneBody, SceneMaterial,
 };
 use crate::body::BodyKind;
 use crate::boundary::Transform;
@@ -14,6 +14,7 @@ pub(super) const NAMES: &[&str] = &[
     "dam_break_small",
     "fountain",
     "honey_dam_break",
+    "oil_on_water",
     "floating_boxes",
     "wave_tank",
     "dam_break_30k",
@@ -48,6 +49,24 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             scene.params.kinematic_viscosity = 0.01;
             Some(scene)
         }
+        "oil_on_water" => {
+            let mut scene = dam_break(
+                name,
+                "A 12x16x12 column of oil (800 kg/m³) collapses onto a layer of water 4 particles deep (38x4x12) in a 2 x 1.5 x 0.65 m box and spreads over it. Walls r/4 outside the nominal box.",
+                [38, 4, 12],
+                [2.00625, 1.50625, 0.65625],
+                2.0,
+            );
+            scene.materials.push(SceneMaterial {
+                name: "oil".into(),
+                rest_density: 800.0,
+            });
+            scene.fluid_blocks.push(FluidBlock {
+                material: Some("oil".into()),
+                ..block([0.05, 0.25, 0.05], [12, 16, 12])
+            });
+            Some(scene)
+        }
         "dam_break_30k" => Some(dam_break(
             name,
             "A 30x40x25 block of water (30,000 particles) collapses in a 5 x 3 x 1.3 m box. The walls sit r/4 = 0.00625 m outside the nominal box [0, L] so that no particle starts compressed in a three-wall corner.",
@@ -70,6 +89,7 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             2.0,
         )),
         "double_dam_break_128k" => Some(Scene {
+            materials: Vec::new(),
             fluid_blocks: vec![
                 block([0.05; 3], [32, 50, 40]),
                 block([6.4, 0.05, 0.05], [32, 50, 40]),
@@ -83,6 +103,7 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             )
         }),
         "obstacle_298k" => Some(Scene {
+            materials: Vec::new(),
             fluid_blocks: vec![
                 block([0.05; 3], [53, 53, 53]),
                 block([5.35, 0.05, 5.35], [53, 53, 53]),
@@ -133,6 +154,7 @@ fn wave_tank() -> Scene {
         }),
     };
     Scene {
+        materials: Vec::new(),
         fluid_blocks: vec![block([0.35, 0.05, 0.05], [83, 15, 24])],
         bodies: vec![paddle],
         ..dam_break(
@@ -163,6 +185,7 @@ fn fountain() -> Scene {
         max: [0.2, 0.15, 0.2],
     };
     let mut scene = Scene {
+        materials: Vec::new(),
         fluid_blocks: vec![block([0.05; 3], [19, 4, 19])],
         emitters: vec![emitter],
         sinks: vec![drain],
@@ -212,6 +235,7 @@ fn block(start: [f64; 3], count: [usize; 3]) -> FluidBlock {
         start,
         count,
         velocity: [0.0; 3],
+        material: None,
     }
 }
 
@@ -242,6 +266,7 @@ fn dam_break(
         }],
         obstacles: Vec::new(),
         bodies: Vec::new(),
+        materials: Vec::new(),
         fluid_blocks: vec![block([0.05; 3], count)],
         emitters: Vec::new(),
         sinks: Vec::new(),

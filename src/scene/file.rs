@@ -9,7 +9,7 @@ mod print;
 #[cfg(test)]
 mod tests;
 
-use super::{BoxSpec, ContainerSpec, FluidBlock, OutputSpec, Scene};
+use super::{BoxSpec, ContainerSpec, FluidBlock, OutputSpec, Scene, SceneMaterial};
 use crate::Error;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use crate::probe::ProbeSet;
@@ -41,6 +41,8 @@ struct SceneFile {
     obstacles: Option<Vec<ObstacleFile>>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     bodies: Option<Vec<BodyFile>>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    materials: Option<Vec<SceneMaterial>>,
     fluid_blocks: Vec<FluidBlock>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     emitters: Option<Vec<EmitterFile>>,
@@ -271,6 +273,7 @@ impl SceneFile {
             containers: self.container.map(|c| c.0).unwrap_or_default(),
             obstacles,
             bodies,
+            materials: self.materials.unwrap_or_default(),
             fluid_blocks: self.fluid_blocks,
             emitters,
             sinks: self.sinks.unwrap_or_default(),
@@ -308,6 +311,7 @@ impl SceneFile {
             .filter(|o: &Vec<ObstacleFile>| !o.is_empty()),
             bodies: Some(scene.bodies.iter().map(BodyFile::from_body).collect())
                 .filter(|b: &Vec<BodyFile>| !b.is_empty()),
+            materials: Some(scene.materials.clone()).filter(|m| !m.is_empty()),
             fluid_blocks: scene.fluid_blocks.clone(),
             emitters: Some(scene.emitters.iter().map(EmitterFile::from_spec).collect())
                 .filter(|e: &Vec<EmitterFile>| !e.is_empty()),

@@ -42,6 +42,20 @@ pub struct FluidBlock {
     /// Initial velocity of every particle in the block (m/s; default 0).
     #[serde(default)]
     pub velocity: [f64; 3],
+    /// The name of the scene's material the block is made of (one of [`super::Scene`]'s
+    /// `materials`; `None`: the world's own fluid, of `rest_density`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub material: Option<String>,
+}
+
+/// A liquid besides the world's own fluid (docs/method.md §14), named for the fluid blocks.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneMaterial {
+    /// The name fluid blocks give in their `material` key (unique, not empty).
+    pub name: String,
+    /// Rest density ρ0 (kg/m³), between a tenth and ten times the scene's `rest_density`.
+    pub rest_density: f64,
 }
 
 impl FluidBlock {

@@ -64,9 +64,17 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
             "must not be empty (a scene needs at least one block of fluid)",
         ));
     }
+    check_materials(scene)?;
     let mut total = 0usize;
     for (i, b) in scene.fluid_blocks.iter().enumerate() {
         check_block(i, b)?;
+        if let Some(name) = b.material.as_ref().filter(|_| scene.material_id(b) == 0) {
+            return Err(Error::invalid(
+                format!("fluid_blocks[{i}].material"),
+                format!("{name:?}"),
+                "must name one of the scene's materials",
+            ));
+        }
         total = total.saturating_add(b.particle_count());
         if total > MAX_PARTICLES {
             return Err(Error::invalid(
@@ -79,6 +87,35 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
     }
     super::flow::check_flow(scene)?;
     check_probes(scene)
+}
+
+/// The materials: unique, non-empty names and rest densities a world of the scene's rest
+/// density takes (docs/method.md §14).
+fn check_materials(scene: &Scene) -> Result<(), Error> {
+    let limit = crate::material::MAX_MATERIALS - 1;
+    if scene.materials.len() > limit {
+        return Err(Error::invalid(
+            "materials",
+            scene.materials.len(),
+            &format!("must hold at most {limit} materials"),
+        ));
+    }
+    for (i, m) in scene.materials.iter().enumerate() {
+        if m.name.is_empty() || scene.materials[..i].iter().any(|o| o.name == m.name) {
+            return Err(Error::invalid(
+                format!("materials[{i}].name"),
+                format!("{:?}", m.name),
+                "must be a name no other material has",
+            ));
+        }
+        let material = crate::Material {
+            rest_density: m.rest_density,
+        };
+        material
+            .check(scene.params.rest_density)
+            .map_err(|e| super::prefixed(e, &format!("materials[{i}].")))?;
+    }
+    Ok(())
 }
 
 /// The probes on their own and against the scene's gravity and containers; a rate of at most
@@ -356,6 +393,61 @@ mod tests {
             message(Scene::from_json(&text)),
             "particle_radius must be a positive finite number, got -0.1"
         );
+    }
+
+    #[test]
+    fn materials_are_read_built_and_checked() {
+        let scene = |materials: &str, block: &str| {
+            format!(
+                r#"{{"particle_radius": 0.05, "duration": 1,
+                "container": {{"min": [0, 0, 0], "max": [2, 2, 2]}},
+                "materials": {materials},
+                "fluid_blocks": [{{"start": [0.2, 0.2, 0.2], "count": [2, 2, 2]}},
+                                 {{"start": [0.2, 0.8, 0.2], "count": [2, 2, 2]{block}}}]}}"#
+            )
+        };
+        let oil = r#"[{"name": "oil", "rest_density": 800}]"#;
+        let good = Scene::from_json(&scene(oil, r#", "material": "oil""#)).unwrap();
+        assert_eq!(good.materials[0].rest_density, 800.0);
+        let world = good.build_world().unwrap();
+        assert_eq!(world.material_count(), 2);
+        assert_eq!(world.particle_materials(), [[0; 8], [1; 8]].concat());
+        assert_eq!(world.fluid_material(), 0);
+        assert_eq!(Scene::from_json(&good.to_json()).unwrap(), good);
+        let cases = [
+            (
+                oil.to_string(),
+                r#", "material": "tar""#,
+                vec!["fluid_blocks[1].material", "tar"],
+            ),
+            (
+                r#"[{"name": "oil", "rest_density": 5}]"#.into(),
+                "",
+                vec!["materials[0].rest_density", "5"],
+            ),
+            (
+                r#"[{"name": "", "rest_density": 800}]"#.into(),
+                "",
+                vec!["materials[0].name"],
+            ),
+            (
+                r#"[{"name": "a", "rest_density": 800}, {"name": "a", "rest_density": 900}]"#
+                    .into(),
+                "",
+                vec!["materials[1].name", "\"a\""],
+            ),
+            (
+                r#"[{"name": "a", "density": 800}]"#.into(),
+                "",
+                vec!["unknown field `density`"],
+            ),
+        ];
+        for (materials, block, parts) in cases {
+            assert_names(
+                &message(Scene::from_json(&scene(&materials, block))),
+                &parts,
+            );
+        }
     }
 
     #[test]

@@ -157,6 +157,7 @@ impl Setup {
             .map(tidy),
             count: [nx, ny, nz],
             velocity: [0.0; 3],
+            material: None,
         };
         let obstacles = if self.obstacle {
             // The sampled box: r inside every face the water meets, its bottom on the floor's
@@ -206,6 +207,7 @@ impl Setup {
             containers: vec![container],
             obstacles,
             bodies: Vec::new(),
+            materials: Vec::new(),
             fluid_blocks: vec![fluid],
             emitters: Vec::new(),
             sinks: Vec::new(),

@@ -3,7 +3,8 @@
 # shared assets of ../shared/anchors/splishsplash (or $SPLISHSPLASH):
 #   bench/splishsplash/run.sh SCENE THREADS SECONDS     e.g. run.sh dam_break_1m_dfsph 2 0.1
 # SCENE is a file name here without .json; it has exactly the geometry of projfluid's scene of
-# the same name without the suffix (r, lattice, tank). Prints the solver's wall time.
+# the same name without the suffix (built in, or bench/NAME.json): r, lattice, tank. Prints the
+# solver's wall time; scenes that export frames write them to the directory given fourth.
 set -euo pipefail
 HERE=$(cd "$(dirname "$0")" && pwd)
 ANCHOR=${SPLISHSPLASH:-$HERE/../../../shared/anchors/splishsplash}

@@ -22,7 +22,7 @@
  * Version of the binary interface these declarations describe; compare it with
  * pf_abi_version() at run time to detect a declarations/library mismatch.
  */
-enum { PF_ABI_VERSION = 4 };
+enum { PF_ABI_VERSION = 5 };
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -153,6 +153,21 @@ typedef enum PfBodyKind {
 } PfBodyKind;
 
 /**
+ * The values of `PfParams.backend`, a `uint32_t`: where a world's steps run.
+ */
+typedef enum PfBackend {
+    /**
+     * The world's own threads, in double precision (the default).
+     */
+    PF_BACKEND_CPU = 0,
+    /**
+     * A graphics card through Vulkan compute shaders, in single precision: only in a
+     * library built with the `gpu` feature, on a machine with a Vulkan adapter.
+     */
+    PF_BACKEND_GPU = 1,
+} PfBackend;
+
+/**
  * An opaque simulation world: fluid particles, boundary particles, parameters and its own
  * worker threads. Create it with `pf_world_create`, free it with `pf_world_destroy`.
  *
@@ -189,7 +204,7 @@ typedef struct PfTransform {
  * `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
  * validates it. The struct is plain data owned by the caller; the library copies it.
  * Fields added in later versions are appended at its end (`kinematic_viscosity` and
- * `no_slip` in ABI version 4), and each addition raises `PF_ABI_VERSION`.
+ * `no_slip` in ABI version 4, `backend` in 5), and each addition raises `PF_ABI_VERSION`.
  */
 typedef struct PfParams {
     /**
@@ -319,6 +334,16 @@ typedef struct PfParams {
      * Default 1.
      */
     uint32_t no_slip;
+    /**
+     * Where the world's steps run, a `PfBackend` value: `PF_BACKEND_CPU` (0) or
+     * `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
+     * a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
+     * no world, where it cannot be had; `pf_params_validate` checks only the value. A world
+     * on the GPU refuses bodies, emitters, walls built as fields, further materials and
+     * solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only
+     * with `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+     */
+    uint32_t backend;
 } PfParams;
 
 /**
@@ -491,8 +516,10 @@ enum PfStatus pf_params_default(struct PfParams *out);
 enum PfStatus pf_params_calm(struct PfParams *params);
 
 /**
- * Checks `*params` without creating a world: `PF_OK` when `pf_world_create` would accept it,
- * otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field.
+ * Checks `*params` without creating a world: `PF_OK` when every field holds a valid value,
+ * otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field. Whether
+ * `backend = PF_BACKEND_GPU` can be had (the library's `gpu` feature, a Vulkan adapter, a
+ * solver and viscosity the GPU runs) is known only when `pf_world_create` opens it.
  *
  * # Safety
  * `params` must be NULL or point to a readable `PfParams`.
@@ -535,8 +562,13 @@ uint32_t pf_abi_version(void);
  * stores its handle in `*out`. The caller owns the world and frees it with
  * `pf_world_destroy`. On failure `*out` is set to NULL (when `out` is not NULL).
  *
+ * With `params->backend = PF_BACKEND_GPU` the world steps on the GPU, which is opened here.
+ *
  * Errors: `PF_ERROR_NULL_POINTER` (params or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a bad
- * parameter, named in the message).
+ * parameter, named in the message; and for the GPU, a message starting `backend gpu: `
+ * that says what is missing: `not available: this build of projfluid has no `gpu`
+ * feature`, no Vulkan adapter, or a solver or `kinematic_viscosity` the GPU backend does
+ * not run). No world is made then; there is no fallback to the CPU.
  *
  * # Safety
  * `params` must be NULL or point to a readable `PfParams`; `out` must be NULL or point to a writable `PfWorld*`.
@@ -1254,7 +1286,8 @@ enum PfStatus pf_world_get_wall_force(const struct PfWorld *world,
  * (the message lists the built-in names); a file that cannot be read, is not valid JSON or
  * not a valid scene (the message starts with the path and names the key and value, or the
  * line and column); an obstacle or body mesh that cannot be read or sampled
- * (`obstacles[i]: …`, `bodies[i]: …`).
+ * (`obstacles[i]: …`, `bodies[i]: …`); a scene whose `backend` is `"gpu"` where the GPU
+ * cannot be had, or with what it does not step (as `pf_world_create`, `backend gpu: …`).
  * Thread safety: may be called from any thread; each call makes its own world.
  *
  * # Safety

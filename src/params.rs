@@ -2,6 +2,8 @@
 
 mod validate;
 
+use crate::Backend;
+
 /// Which global solver runs in each outer iteration (docs/method.md §3).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum SolverKind {
@@ -82,6 +84,7 @@ macro_rules! serde_by_name {
 }
 
 serde_by_name!(SolverKind);
+serde_by_name!(Backend);
 
 /// How ω₂, the first Chebyshev weight, is chosen (docs/method.md §3.7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -265,6 +268,11 @@ pub struct Params {
     pub no_slip: bool,
     /// Worker threads of the world's own pool (0 = one per core).
     pub threads: usize,
+    /// Where the world's steps run: [`Backend::Cpu`], the default, or [`Backend::Gpu`]
+    /// (feature `gpu`), which [`crate::World::new`] opens, failing where the build has no
+    /// `gpu` feature or the machine no Vulkan adapter. [`crate::World::set_backend`]
+    /// changes it.
+    pub backend: Backend,
 }
 
 /// The longest time step (s) a world takes: the bound on `dt_min`, `dt_max` and
@@ -366,6 +374,7 @@ impl Params {
             kinematic_viscosity: 0.0,
             no_slip: true,
             threads: 0,
+            backend: Backend::Cpu,
         }
     }
 
@@ -444,14 +453,15 @@ mod tests {
     }
 
     /// The calm settings change the weighting, τ (scaled by the radius), the Chebyshev
-    /// settings, the warm start and the coarse correction, keep every other field, and
-    /// validate.
+    /// settings, the warm start and the coarse correction, keep every other field (the
+    /// backend among them), and validate.
     #[test]
     fn calm_changes_only_the_solver_settings() {
         let base = Params {
             solver: SolverKind::Jacobi1,
             threads: 3,
             warm_start: 0.5,
+            backend: Backend::Gpu,
             ..Params::with_radius(0.01)
         };
         let calm = base.clone().calm();

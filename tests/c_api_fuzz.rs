@@ -518,7 +518,7 @@ impl Fuzzer {
                     ok(pf_params_default(params.as_mut_ptr()), "params_default");
                     let mut p = params.assume_init();
                     p.threads = 1;
-                    match self.rng.below(8) {
+                    match self.rng.below(9) {
                         0 => p.dt_max = double(&mut self.rng, &[1e-3, 1.0, 1.5]),
                         1 => p.dt_initial = double(&mut self.rng, &[1e-3, 1.0, 2.0]),
                         2 => p.dt_min = double(&mut self.rng, &[1e-5, 1e-2]),
@@ -526,6 +526,7 @@ impl Fuzzer {
                         4 => p.chebyshev_rho = double(&mut self.rng, &[0.5, 0.99, 1.0]),
                         5 => p.kinematic_viscosity = double(&mut self.rng, &[0.0, 1e-6, 1e-2]),
                         6 => p.no_slip = self.rng.below(3) as u32,
+                        7 => p.backend = self.rng.below(3) as u32,
                         _ => p.viscosity = double(&mut self.rng, &[0.0, 0.5, 2.0]),
                     }
                     let mut other = self.world;

@@ -1,11 +1,24 @@
 //! The GPU backend (feature `gpu`) against the CPU: a dam break and a tank at rest on the
-//! first Vulkan adapter (in CI, Mesa's software device lavapipe). A missing adapter fails
-//! these tests with the reason; it does not skip them.
+//! first Vulkan adapter (in CI, Mesa's software device lavapipe); the backend chosen through
+//! `Params::backend`, the C API's `PfParams.backend` and the scene key `backend`. A missing
+//! adapter fails these tests with the reason; it does not skip them.
 #![cfg(feature = "gpu")]
 
 use projfluid::boundary::Aabb;
+use projfluid::checkpoint::{read_checkpoint, write_checkpoint};
+use projfluid::ffi::{
+    PfBackend, PfParams, PfPose, PfSolver, PfStatus, pf_last_error_message, pf_params_default,
+    pf_pose_identity, pf_world_add_body_box, pf_world_add_container_box,
+    pf_world_add_container_field, pf_world_add_fluid_box, pf_world_body_count, pf_world_create,
+    pf_world_destroy, pf_world_fluid_count, pf_world_get_params, pf_world_get_positions,
+    pf_world_positions_hash, pf_world_step,
+};
+use projfluid::material::Material;
 use projfluid::scene::Scene;
-use projfluid::{Backend, Params, Vec3, World};
+use projfluid::{Backend, ChebyshevParams, Params, SolverKind, Vec3, World};
+use std::ffi::CStr;
+use std::mem::MaybeUninit;
+use std::ptr;
 
 /// `world` switched to the GPU backend, or a failure that says why it cannot be.
 fn on_gpu(mut world: World) -> World {
@@ -291,4 +304,302 @@ fn missing_adapter_probe() {
     );
     assert_eq!(world.backend(), Backend::Cpu);
     world.step().expect("the CPU still steps");
+}
+
+/// Steps of the small tank below, on the device: enough to move its fluid, few enough to keep
+/// the tests short on a software device.
+const TANK_STEPS: usize = 4;
+
+/// A 0.5 m box with walls of particles, and an 8 × 8 × 8 block of water in its corner
+/// (values that `float` holds exactly, so that the C API's worlds are the same).
+fn fill_small_tank(world: &mut World) {
+    let container = Aabb {
+        min: Vec3::zeros(),
+        max: Vec3::repeat(0.5),
+    };
+    world.add_container(container, 1).expect("container");
+    world
+        .add_fluid_block(Vec3::repeat(0.0625), [8, 8, 8], Vec3::zeros())
+        .expect("fluid");
+}
+
+/// A world made with `Params { backend: Backend::Gpu, .. }`, or a failure that says why not.
+fn made_on_gpu() -> World {
+    let params = Params {
+        backend: Backend::Gpu,
+        ..Params::default()
+    };
+    World::new(params).unwrap_or_else(|e| {
+        panic!(
+            "the GPU backend is unavailable: {e}. These tests need a Vulkan adapter; \
+             on Debian install mesa-vulkan-drivers and libvulkan1 (lavapipe)"
+        )
+    })
+}
+
+/// A world made on the GPU through its parameters steps as one made on the CPU and switched
+/// there, to the bit; both report the backend in their parameters, and switching back to the
+/// CPU sets them back. A world on the GPU refuses, changing nothing, what the GPU backend
+/// does not step: walls built as fields, a further material, a solver it does not run.
+#[test]
+fn a_world_made_on_the_gpu_steps_as_one_switched_there() {
+    let mut made = made_on_gpu();
+    assert_eq!(
+        (made.backend(), made.params().backend),
+        (Backend::Gpu, Backend::Gpu)
+    );
+    fill_small_tank(&mut made);
+    let mut switched = World::new(Params::default()).expect("parameters");
+    fill_small_tank(&mut switched);
+    let mut switched = on_gpu(switched);
+    assert_eq!(switched.params(), made.params());
+    let start = made.positions();
+    for _ in 0..TANK_STEPS {
+        made.step().expect("a step on the GPU");
+        switched.step().expect("a step on the GPU");
+    }
+    assert!(made.positions() == switched.positions(), "positions differ");
+    assert!(
+        made.velocities() == switched.velocities(),
+        "velocities differ"
+    );
+    assert_eq!(made.time().to_bits(), switched.time().to_bits());
+    assert!(made.positions() != start, "the fluid did not move");
+
+    let field = Aabb {
+        min: Vec3::repeat(1.0),
+        max: Vec3::repeat(2.0),
+    };
+    let before = made.positions_hash();
+    let refusals = [
+        (
+            made.add_container_field(field).err(),
+            "container walls built as fields",
+        ),
+        (
+            made.add_material(Material {
+                rest_density: 800.0,
+            })
+            .err(),
+            "several fluid materials",
+        ),
+        (
+            made.set_solver(SolverKind::Cg, ChebyshevParams::default())
+                .err(),
+            "the cg solver",
+        ),
+    ];
+    for (error, what) in refusals {
+        assert_eq!(
+            error.map(|e| e.to_string()),
+            Some(format!(
+                "backend gpu: does not support {what} yet; use the CPU backend"
+            ))
+        );
+    }
+    assert_eq!(made.positions_hash(), before);
+    assert_eq!(made.containers().len(), 1);
+    assert_eq!(made.material_count(), 1);
+    assert_eq!(made.params().solver, SolverKind::Chebyshev);
+
+    made.set_backend(Backend::Cpu)
+        .expect("the CPU is always there");
+    assert_eq!(
+        (made.backend(), made.params().backend),
+        (Backend::Cpu, Backend::Cpu)
+    );
+    made.step().expect("the CPU steps it on");
+}
+
+/// The C API's last error message.
+fn last_error() -> String {
+    // SAFETY: never NULL, NUL-terminated, valid until this thread's next call.
+    unsafe { CStr::from_ptr(pf_last_error_message()) }
+        .to_string_lossy()
+        .into_owned()
+}
+
+/// `pf_params_default` with `backend` set to `backend`.
+fn c_params(backend: u32) -> PfParams {
+    let mut params = MaybeUninit::<PfParams>::uninit();
+    // SAFETY: a writable PfParams.
+    assert_eq!(
+        unsafe { pf_params_default(params.as_mut_ptr()) },
+        PfStatus::PF_OK
+    );
+    // SAFETY: filled above.
+    let mut params = unsafe { params.assume_init() };
+    params.backend = backend;
+    params
+}
+
+/// Through the C API: a world created with `PfParams.backend = PF_BACKEND_GPU` reports the
+/// backend, fills, steps and reads as the Rust API's world on the GPU does, to the bit, and
+/// refuses a body and walls built as fields with the GPU backend's message, changing
+/// nothing. An unknown backend, and the GPU with a solver it does not run, make no world.
+#[test]
+fn the_c_api_steps_a_world_on_the_gpu_and_refuses_its_misuse() {
+    const GPU: u32 = PfBackend::PF_BACKEND_GPU as u32;
+    let ok = |status: PfStatus, call: &str| {
+        assert_eq!(status, PfStatus::PF_OK, "{call}: {}", last_error());
+    };
+    let params = c_params(GPU);
+    let mut world = ptr::null_mut();
+    // SAFETY: valid pointers throughout; the world is destroyed once, at the end.
+    unsafe {
+        ok(pf_world_create(&params, &mut world), "pf_world_create");
+        let mut back = c_params(0);
+        ok(pf_world_get_params(world, &mut back), "pf_world_get_params");
+        assert_eq!(back.backend, GPU);
+        let (lo, hi) = ([0.0f32; 3], [0.5f32; 3]);
+        ok(
+            pf_world_add_container_box(world, lo.as_ptr(), hi.as_ptr(), 1),
+            "pf_world_add_container_box",
+        );
+        let (start, count) = ([0.0625f32; 3], [8usize; 3]);
+        ok(
+            pf_world_add_fluid_box(world, start.as_ptr(), count.as_ptr(), ptr::null()),
+            "pf_world_add_fluid_box",
+        );
+        for _ in 0..TANK_STEPS {
+            ok(pf_world_step(world, 0.0), "pf_world_step");
+        }
+        let mut positions = vec![0.0f32; 3 * 512];
+        let mut needed = 0;
+        ok(
+            pf_world_get_positions(world, positions.as_mut_ptr(), positions.len(), &mut needed),
+            "pf_world_get_positions",
+        );
+        assert_eq!(needed, positions.len());
+        let mut rust = made_on_gpu();
+        fill_small_tank(&mut rust);
+        for _ in 0..TANK_STEPS {
+            rust.step().expect("a step on the GPU");
+        }
+        let expected: Vec<f32> = rust
+            .positions()
+            .iter()
+            .flat_map(|p| [p.x as f32, p.y as f32, p.z as f32])
+            .collect();
+        assert!(
+            positions == expected,
+            "the C API's world differs from the Rust API's"
+        );
+
+        let mut hash = [0u8; 65];
+        let hash_of = |world, hash: &mut [u8; 65]| {
+            let mut needed = 0;
+            ok(
+                pf_world_positions_hash(world, hash.as_mut_ptr().cast(), 65, &mut needed),
+                "pf_world_positions_hash",
+            );
+            *hash
+        };
+        let before = hash_of(world, &mut hash);
+        let mut pose = MaybeUninit::<PfPose>::uninit();
+        ok(pf_pose_identity(pose.as_mut_ptr()), "pf_pose_identity");
+        let pose = pose.assume_init();
+        let half = [0.05f64; 3];
+        let mut id = usize::MAX;
+        assert_eq!(
+            pf_world_add_body_box(world, 1, half.as_ptr(), 0.0, &pose, &mut id),
+            PfStatus::PF_ERROR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            last_error(),
+            "pf_world_add_body_box: backend gpu: does not support bodies yet; use the CPU backend"
+        );
+        assert_eq!(id, usize::MAX);
+        let (far_lo, far_hi) = ([1.0f32; 3], [2.0f32; 3]);
+        assert_eq!(
+            pf_world_add_container_field(world, far_lo.as_ptr(), far_hi.as_ptr()),
+            PfStatus::PF_ERROR_INVALID_ARGUMENT
+        );
+        assert_eq!(
+            last_error(),
+            "pf_world_add_container_field: backend gpu: does not support container walls built \
+             as fields yet; use the CPU backend"
+        );
+        let (mut bodies, mut fluid) = (usize::MAX, 0);
+        ok(
+            pf_world_body_count(world, &mut bodies),
+            "pf_world_body_count",
+        );
+        ok(
+            pf_world_fluid_count(world, &mut fluid),
+            "pf_world_fluid_count",
+        );
+        assert_eq!((bodies, fluid), (0, 512));
+        assert_eq!(hash_of(world, &mut hash), before);
+        ok(
+            pf_world_step(world, 0.0),
+            "pf_world_step after the refusals",
+        );
+        pf_world_destroy(world);
+
+        for (bad, message) in [
+            (
+                c_params(2),
+                "pf_world_create: params->backend must be PF_BACKEND_CPU (0) or PF_BACKEND_GPU \
+                 (1), got 2",
+            ),
+            (
+                PfParams {
+                    solver: PfSolver::PF_SOLVER_CG,
+                    ..c_params(GPU)
+                },
+                "pf_world_create: backend gpu: does not support the cg solver yet; use the CPU \
+                 backend",
+            ),
+        ] {
+            let mut none = ptr::NonNull::dangling().as_ptr();
+            assert_eq!(
+                pf_world_create(&bad, &mut none),
+                PfStatus::PF_ERROR_INVALID_ARGUMENT
+            );
+            assert_eq!(last_error(), message);
+            assert!(none.is_null());
+        }
+    }
+}
+
+/// A scene whose key `backend` is `"gpu"` builds its world on the GPU, and a checkpoint of
+/// that world records the key and resumes on the GPU, where it steps on.
+#[test]
+fn a_scene_for_the_gpu_and_its_checkpoint_run_there() {
+    let mut scene = Scene::builtin("dam_break_small").expect("a built-in scene");
+    scene.fluid_blocks[0].count = [6, 8, 5];
+    let json = scene
+        .to_json()
+        .replace("\"backend\": \"cpu\"", "\"backend\": \"gpu\"");
+    let scene = Scene::from_json(&json).expect("the scene reads");
+    assert_eq!(scene.params.backend, Backend::Gpu);
+    let mut world = scene.build_world().expect("the scene builds on the GPU");
+    assert_eq!(world.backend(), Backend::Gpu);
+    for _ in 0..2 {
+        world.step().expect("a step on the GPU");
+    }
+    let path = std::env::temp_dir().join(format!("projfluid-gpu-{}.pfck", std::process::id()));
+    write_checkpoint(&path, &scene, &world, None).expect("the checkpoint is written");
+    let bytes = std::fs::read(&path).expect("the checkpoint reads");
+    let restored = read_checkpoint(&path, None);
+    std::fs::remove_file(&path).expect("the checkpoint is removed");
+    let key = br#"\"backend\": \"gpu\""#;
+    assert!(
+        bytes.windows(key.len()).any(|w| w == key),
+        "the checkpoint lacks the key"
+    );
+    let mut resumed = restored.expect("the checkpoint resumes").world;
+    assert_eq!(resumed.backend(), Backend::Gpu);
+    assert_eq!(resumed.params(), world.params());
+    assert_eq!(resumed.positions_hash(), world.positions_hash());
+    resumed.step().expect("the resumed world steps on the GPU");
+    world.step().expect("a step on the GPU");
+    let apart = (resumed.positions().iter().zip(world.positions()))
+        .map(|(a, b)| (a - b).norm())
+        .fold(0.0, f64::max);
+    assert!(
+        apart < 1e-4,
+        "the resumed run is {apart} m from the original"
+    );
 }

@@ -48,6 +48,7 @@ class PfParams(ctypes.Structure):
         ("threads", c_uint32),
         ("kinematic_viscosity", c_double),
         ("no_slip", c_uint32),
+        ("backend", c_uint32),
     ]
 
 

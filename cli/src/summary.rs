@@ -12,6 +12,8 @@ pub struct RunSummary {
     pub scene: String,
     /// Global solver name.
     pub solver: String,
+    /// Where the steps ran: `cpu` or `gpu` ([`projfluid::Backend::name`]).
+    pub backend: String,
     /// Chebyshev ρ_c (reported for every solver; used by `chebyshev` only); with `rho_auto`,
     /// the mean online estimate over the steps that extrapolated.
     pub rho: f64,
@@ -156,6 +158,7 @@ impl RunAccumulator {
         RunSummary {
             scene: scene.to_string(),
             solver: p.solver.name().to_string(),
+            backend: world.backend().name().to_string(),
             rho: if p.chebyshev.auto_rho && p.solver == SolverKind::Chebyshev && self.rho_steps > 0
             {
                 self.rho_sum / self.rho_steps as f64

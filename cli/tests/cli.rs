@@ -164,7 +164,14 @@ fn short_run_writes_stats_and_frames() {
         "stderr: {}",
         String::from_utf8_lossy(&out.stderr)
     );
-    for row in ["dam_break_small", "chebyshev", "3840", "escaped", "NaN"] {
+    for row in [
+        "dam_break_small",
+        "chebyshev",
+        "backend                cpu (double precision)",
+        "3840",
+        "escaped",
+        "NaN",
+    ] {
         assert!(
             stdout.contains(row),
             "summary {stdout:?} should mention {row:?}"
@@ -176,6 +183,7 @@ fn short_run_writes_stats_and_frames() {
     let keys = [
         "scene",
         "solver",
+        "backend",
         "rho",
         "tau",
         "coarse_correction",
@@ -200,6 +208,7 @@ fn short_run_writes_stats_and_frames() {
     }
     assert_eq!(json["scene"], "dam_break_small");
     assert_eq!(json["solver"], "chebyshev");
+    assert_eq!(json["backend"], "cpu");
     assert_eq!(json["particles"], 3840);
     assert_eq!(json["steps"], 3);
     assert_eq!(json["threads"], 2);
@@ -1371,4 +1380,50 @@ fn the_gpu_backend_is_refused_where_the_build_lacks_it() {
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
+}
+
+/// The scene key `backend` chooses the backend as `--backend` does, and `--backend`
+/// replaces it: a scene for the GPU is refused in this build (exit 2, naming the backend and
+/// the missing feature, before any stats are written), runs with `--backend cpu`, whose
+/// summary and stats name the CPU; a value other than `cpu` or `gpu` is refused naming the
+/// key.
+#[test]
+fn the_scene_key_backend_chooses_the_backend_and_the_option_replaces_it() {
+    let dir = temp_dir("backend-key");
+    let stats = dir.join("stats.json");
+    let gpu = dir.join("gpu.json");
+    let text = scene_with("\"duration\"", "\"backend\": \"gpu\", \"duration\"");
+    std::fs::write(&gpu, &text).unwrap();
+    let run = |extra: &[&str]| {
+        let mut args = vec!["run", gpu.to_str().unwrap(), "--steps", "1"];
+        args.extend_from_slice(&["--stats", stats.to_str().unwrap()]);
+        args.extend_from_slice(extra);
+        projfluid(&args)
+    };
+    assert_bad_input(
+        &run(&[]),
+        &["backend gpu: not available: this build of projfluid has no `gpu` feature"],
+    );
+    assert!(!stats.exists(), "a refused run wrote {}", stats.display());
+    let out = run(&["--backend", "cpu"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("backend                cpu (double precision)"),
+        "{stdout}"
+    );
+    let json: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+    assert_eq!(
+        (&json["backend"], &json["steps"]),
+        (&"cpu".into(), &1.into())
+    );
+    let out = run_scene_text(&dir, "tpu.json", &text.replace("\"gpu\"", "\"tpu\""));
+    assert_bad_input(&out, &["tpu.json", "backend", "tpu", "`cpu`", "`gpu`"]);
+    std::fs::remove_dir_all(&dir).unwrap();
 }

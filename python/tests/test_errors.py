@@ -181,6 +181,32 @@ def test_values_c_cannot_hold_are_python_errors() -> None:
             world.add_body_sphere("floating", 0.1)
 
 
+NO_GPU = "backend gpu: not available: this build of projfluid has no `gpu` feature"
+
+
+def test_the_gpu_is_refused_where_the_library_lacks_it(tmp_path: Path) -> None:
+    # The tests' library is built without the `gpu` feature: the choice is a valid value,
+    # but no world is made on the GPU, neither from parameters nor from a scene.
+    params = projfluid.Params(backend="gpu", threads=1)
+    with pytest.raises(InvalidArgumentError) as caught:
+        projfluid.World(params)
+    assert caught.value.status == Status.ERROR_INVALID_ARGUMENT
+    assert caught.value.message == f"pf_world_create: {NO_GPU}"
+    scene = tmp_path / "gpu.json"
+    scene.write_text(
+        '{"particle_radius": 0.025, "backend": "gpu", "duration": 1,'
+        ' "container": {"min": [0, 0, 0], "max": [0.5, 0.5, 0.5]},'
+        ' "fluid_blocks": [{"start": [0.0625, 0.0625, 0.0625], "count": [2, 2, 2]}]}'
+    )
+    with pytest.raises(InvalidArgumentError) as caught:
+        projfluid.load_scene(scene)
+    assert caught.value.message == f"pf_world_create_from_scene: {NO_GPU}"
+    # The same scene on the CPU makes its world.
+    scene.write_text(scene.read_text().replace('"gpu"', '"cpu"'))
+    with projfluid.load_scene(scene) as world:
+        assert world.params.backend == "cpu" and world.fluid_count == 8
+
+
 def test_unknown_scenes_and_bad_scene_files_raise_the_c_message(tmp_path: Path) -> None:
     with pytest.raises(InvalidArgumentError) as caught:
         projfluid.load_scene("no_such_scene")

@@ -179,6 +179,25 @@ def test_the_physical_viscosity_and_its_wall_condition_reach_the_world() -> None
         small_params(kinematic_viscosity="honey")
 
 
+def test_the_backend_is_a_choice_passed_to_the_c_library() -> None:
+    defaults = projfluid.Params()
+    assert defaults.backend == "cpu" and defaults.to_c().backend == 0
+    gpu = small_params(backend="gpu")
+    c = gpu.to_c()
+    assert c.backend == 1
+    assert projfluid.Params.from_c(c) == gpu
+    assert gpu.calm().backend == "gpu"
+    assert small_params(backend="GPU") == gpu
+    for bad in ("tpu", "", 1, None):
+        with pytest.raises(ValueError, match=r"^backend must be 'cpu' or 'gpu', got "):
+            small_params(backend=bad)
+    c.backend = 7
+    with pytest.raises(ValueError, match=r"^backend must be 'cpu' or 'gpu', got 7$"):
+        projfluid.Params.from_c(c)
+    with projfluid.World(small_params(backend="cpu")) as world:
+        assert world.params.backend == "cpu"
+
+
 def _sliding_speed(**settings: object) -> float:
     """Mean x velocity (m/s) of a block sliding at 0.2 m/s along the floor of a tank without
     gravity or XSPH, after one step of 2 ms."""

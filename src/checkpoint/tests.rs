@@ -212,6 +212,46 @@ fn damaged_truncated_and_foreign_files_are_refused() {
     assert!(msg.starts_with("cannot read checkpoint"), "{msg}");
 }
 
+/// The checkpoint's scene records the world's backend. One that records the GPU resumes on
+/// it, so in a build without the `gpu` feature it is refused naming the backend and the
+/// missing feature (here a CPU checkpoint edited to say `gpu`, its digest made anew).
+#[test]
+fn the_backend_travels_with_the_checkpoint() {
+    let scene = small_scene();
+    let mut world = scene.build_world().unwrap();
+    world.step().unwrap();
+    let path = temp("backend.pfck");
+    write_checkpoint(&path, &scene, &world, None).unwrap();
+    let resumed = read_checkpoint(&path, None).unwrap();
+    assert_eq!(resumed.scene.params.backend, crate::Backend::Cpu);
+    assert_eq!(resumed.world.backend(), crate::Backend::Cpu);
+    let bytes = std::fs::read(&path).unwrap();
+    // The scene is a JSON string inside the JSON header: its quotes are escaped.
+    let (cpu, gpu) = (
+        &br#"\"backend\": \"cpu\""#[..],
+        &br#"\"backend\": \"gpu\""#[..],
+    );
+    let at = bytes
+        .windows(cpu.len())
+        .position(|w| w == cpu)
+        .expect("the checkpoint's scene names its backend");
+    let mut edited = bytes[..bytes.len() - DIGEST_LEN].to_vec();
+    edited[at..at + gpu.len()].copy_from_slice(gpu);
+    let digest = Sha256::digest(&edited);
+    edited.extend_from_slice(&digest);
+    std::fs::write(&path, &edited).unwrap();
+    let read = read_checkpoint(&path, None).map(|c| c.world.backend());
+    std::fs::remove_file(&path).unwrap();
+    #[cfg(not(feature = "gpu"))]
+    assert_eq!(
+        read.map_err(|e| e.to_string()),
+        Err("backend gpu: not available: this build of projfluid has no `gpu` feature".into())
+    );
+    // With the feature it resumes on the GPU where a Vulkan adapter is (tests/gpu.rs).
+    #[cfg(feature = "gpu")]
+    assert!(matches!(read, Ok(crate::Backend::Gpu) | Err(_)));
+}
+
 /// A run with an emitter, a sink, a domain and removed particles resumes bit for bit: ids,
 /// the removed count, the emitter's progress and the boxes are in the checkpoint.
 #[test]

@@ -31,7 +31,7 @@ mod scene;
 
 pub use body::*;
 pub use mesh::*;
-pub use params::{PfOmega2Rule, PfParams, PfProjectionWeight, PfSolver};
+pub use params::{PfBackend, PfOmega2Rule, PfParams, PfProjectionWeight, PfSolver};
 pub use params::{pf_params_default, pf_params_validate};
 pub use scene::pf_world_create_from_scene;
 pub use status::{PfStatus, pf_last_error_message, pf_status_name};

@@ -2,6 +2,7 @@
 
 use super::checked::Args;
 use super::status::{Failure, PfStatus, status_call};
+use crate::Backend;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use std::ffi::c_int;
 use std::ptr;
@@ -49,6 +50,18 @@ pub enum PfProjectionWeight {
     PF_WEIGHT_UNIFORM = 2,
 }
 
+/// The values of `PfParams.backend`, a `uint32_t`: where a world's steps run.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[allow(non_camel_case_types)]
+pub enum PfBackend {
+    /// The world's own threads, in double precision (the default).
+    PF_BACKEND_CPU = 0,
+    /// A graphics card through Vulkan compute shaders, in single precision: only in a
+    /// library built with the `gpu` feature, on a machine with a Vulkan adapter.
+    PF_BACKEND_GPU = 1,
+}
+
 // Enum fields are read from C memory as plain ints before they are checked.
 const _: () = assert!(size_of::<PfSolver>() == size_of::<c_int>());
 const _: () = assert!(size_of::<PfOmega2Rule>() == size_of::<c_int>());
@@ -58,7 +71,7 @@ const _: () = assert!(size_of::<PfProjectionWeight>() == size_of::<c_int>());
 /// `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
 /// validates it. The struct is plain data owned by the caller; the library copies it.
 /// Fields added in later versions are appended at its end (`kinematic_viscosity` and
-/// `no_slip` in ABI version 4), and each addition raises `PF_ABI_VERSION`.
+/// `no_slip` in ABI version 4, `backend` in 5), and each addition raises `PF_ABI_VERSION`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PfParams {
@@ -137,6 +150,14 @@ pub struct PfParams {
     /// as fields let it slide either way; no effect while `kinematic_viscosity` is 0.
     /// Default 1.
     pub no_slip: u32,
+    /// Where the world's steps run, a `PfBackend` value: `PF_BACKEND_CPU` (0) or
+    /// `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
+    /// a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
+    /// no world, where it cannot be had; `pf_params_validate` checks only the value. A world
+    /// on the GPU refuses bodies, emitters, walls built as fields, further materials and
+    /// solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only
+    /// with `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+    pub backend: u32,
 }
 
 impl From<&Params> for PfParams {
@@ -183,6 +204,10 @@ impl From<&Params> for PfParams {
             threads: small(p.threads),
             kinematic_viscosity: p.kinematic_viscosity,
             no_slip: u32::from(p.no_slip),
+            backend: match p.backend {
+                Backend::Cpu => PfBackend::PF_BACKEND_CPU as u32,
+                Backend::Gpu => PfBackend::PF_BACKEND_GPU as u32,
+            },
         }
     }
 }
@@ -248,6 +273,15 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
     let auto_rho = switch(field!(chebyshev_auto_rho), "chebyshev_auto_rho")?;
     let coarse_correction = switch(field!(coarse_correction), "coarse_correction")?;
     let no_slip = switch(field!(no_slip), "no_slip")?;
+    let backend = match field!(backend) {
+        0 => Backend::Cpu,
+        1 => Backend::Gpu,
+        n => {
+            return Err(Failure::invalid(format!(
+                "params->backend must be PF_BACKEND_CPU (0) or PF_BACKEND_GPU (1), got {n}"
+            )));
+        }
+    };
     let count = |n: u32| n as usize;
     let params = Params {
         particle_radius: field!(particle_radius),
@@ -278,6 +312,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         kinematic_viscosity: field!(kinematic_viscosity),
         no_slip,
         threads: count(field!(threads)),
+        backend,
     };
     params
         .validate()
@@ -318,8 +353,10 @@ pub unsafe extern "C" fn pf_params_calm(params: *mut PfParams) -> PfStatus {
     })
 }
 
-/// Checks `*params` without creating a world: `PF_OK` when `pf_world_create` would accept it,
-/// otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field.
+/// Checks `*params` without creating a world: `PF_OK` when every field holds a valid value,
+/// otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field. Whether
+/// `backend = PF_BACKEND_GPU` can be had (the library's `gpu` feature, a Vulkan adapter, a
+/// solver and viscosity the GPU runs) is known only when `pf_world_create` opens it.
 ///
 /// # Safety
 /// `params` must be NULL or point to a readable `PfParams`.

@@ -23,7 +23,8 @@ use std::ffi::c_char;
 /// (the message lists the built-in names); a file that cannot be read, is not valid JSON or
 /// not a valid scene (the message starts with the path and names the key and value, or the
 /// line and column); an obstacle or body mesh that cannot be read or sampled
-/// (`obstacles[i]: …`, `bodies[i]: …`).
+/// (`obstacles[i]: …`, `bodies[i]: …`); a scene whose `backend` is `"gpu"` where the GPU
+/// cannot be had, or with what it does not step (as `pf_world_create`, `backend gpu: …`).
 /// Thread safety: may be called from any thread; each call makes its own world.
 ///
 /// # Safety
@@ -114,6 +115,31 @@ mod tests {
         assert_eq!(
             message(),
             "pf_world_create_from_scene: name_or_path must not be NULL"
+        );
+    }
+
+    /// A scene whose `backend` is `"gpu"` makes no world in a build without the `gpu`
+    /// feature: the message names the backend and the missing feature.
+    #[cfg(not(feature = "gpu"))]
+    #[test]
+    fn a_scene_for_the_gpu_makes_no_world_without_the_feature() {
+        let mut scene = Scene::builtin("dam_break_small").unwrap();
+        scene.params.backend = crate::Backend::Gpu;
+        let path = std::env::temp_dir().join(format!(
+            "projfluid-ffi-gpu-scene-{}.json",
+            std::process::id()
+        ));
+        std::fs::write(&path, scene.to_json()).unwrap();
+        let mut name = path.to_str().unwrap().as_bytes().to_vec();
+        name.push(0);
+        let (status, world) = create(&name);
+        std::fs::remove_file(&path).unwrap();
+        assert_eq!(status, PfStatus::PF_ERROR_INVALID_ARGUMENT);
+        assert!(world.is_null());
+        assert_eq!(
+            message(),
+            "pf_world_create_from_scene: backend gpu: not available: this build of projfluid \
+             has no `gpu` feature"
         );
     }
 }

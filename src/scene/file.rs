@@ -10,9 +10,9 @@ mod print;
 mod tests;
 
 use super::{BoxSpec, ContainerSpec, FluidBlock, OutputSpec, Scene, SceneMaterial};
-use crate::Error;
 use crate::params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
 use crate::probe::ProbeSet;
+use crate::{Backend, Error};
 use bodies::BodyFile;
 use error::json_error;
 use flow::EmitterFile;
@@ -56,6 +56,7 @@ struct SceneFile {
     kinematic_viscosity: Option<f64>,
     no_slip: Option<bool>,
     threads: Option<usize>,
+    backend: Option<Backend>,
     duration: f64,
     output: Option<OutputFile>,
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -218,6 +219,7 @@ impl SceneFile {
         set(&mut p.kinematic_viscosity, self.kinematic_viscosity);
         p.no_slip = self.no_slip.unwrap_or(p.no_slip);
         p.threads = self.threads.unwrap_or(p.threads);
+        p.backend = self.backend.unwrap_or(p.backend);
         let s = self.solver.unwrap_or_default();
         p.solver = s.kind.unwrap_or(p.solver);
         let c: &mut ChebyshevParams = &mut p.chebyshev;
@@ -345,6 +347,7 @@ impl SceneFile {
             kinematic_viscosity: Some(p.kinematic_viscosity),
             no_slip: Some(p.no_slip),
             threads: Some(p.threads),
+            backend: Some(p.backend),
             duration: scene.duration,
             output: Some(OutputFile {
                 dir: scene

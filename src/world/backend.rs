@@ -1,10 +1,14 @@
 //! Where a world's steps run: on the CPU (the default) or, in builds with the `gpu`
-//! feature, on a graphics card ([`Backend::Gpu`], src/gpu/). The GPU backend steps the
-//! fluid and the static boundary (container walls and obstacles as particles); a world with
-//! what it does not reach yet is refused with an error naming it.
+//! feature, on a graphics card ([`Backend::Gpu`], src/gpu/), chosen by
+//! [`Params::backend`](crate::Params::backend) when the world is made or by
+//! [`World::set_backend`] later. The GPU backend steps the fluid and the static boundary
+//! (container walls and obstacles as particles); what it does not reach yet is refused with
+//! an error naming it, when it is added to a world on the GPU or when a world holding it is
+//! switched there.
 
 use super::World;
 use crate::Error;
+use crate::params::SolverKind;
 
 /// The hardware a world's time steps run on.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -20,12 +24,24 @@ pub enum Backend {
 }
 
 impl Backend {
-    /// The backend's name, as `"cpu"` or `"gpu"`.
+    /// Every backend.
+    pub const ALL: [Backend; 2] = [Backend::Cpu, Backend::Gpu];
+
+    /// Every backend's name, in the order of [`Backend::ALL`].
+    pub const NAMES: [&'static str; 2] = ["cpu", "gpu"];
+
+    /// The backend's name, as `"cpu"` or `"gpu"` (the scene key `backend`, the CLI's
+    /// `--backend`).
     pub fn name(self) -> &'static str {
         match self {
             Backend::Cpu => "cpu",
             Backend::Gpu => "gpu",
         }
+    }
+
+    /// Parses a backend's name (see [`Backend::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|b| b.name() == name)
     }
 }
 
@@ -38,6 +54,16 @@ pub(crate) fn gpu_error(what: &str) -> Error {
     }
 }
 
+/// The GPU backend's refusal of `what`, which it does not step yet.
+fn unsupported(what: &str) -> Error {
+    gpu_error(&format!("does not support {what} yet; use the CPU backend"))
+}
+
+/// Whether the GPU backend steps with the global solver `kind`.
+fn gpu_solver(kind: SolverKind) -> bool {
+    matches!(kind, SolverKind::Chebyshev | SolverKind::Jacobi1)
+}
+
 impl World {
     /// The backend the world steps on.
     pub fn backend(&self) -> Backend {
@@ -48,10 +74,11 @@ impl World {
         Backend::Cpu
     }
 
-    /// Chooses where the world's steps run. [`Backend::Gpu`] opens the first Vulkan
-    /// adapter at once; the fluid is uploaded at the next step. Errors, changing nothing,
-    /// naming the backend and what is missing: a build without the `gpu` feature, no
-    /// Vulkan loader or adapter, or a world with what the GPU backend does not step yet.
+    /// Chooses where the world's steps run, and sets
+    /// [`Params::backend`](crate::Params::backend) to it. [`Backend::Gpu`] opens the first
+    /// Vulkan adapter at once; the fluid is uploaded at the next step. Errors, changing
+    /// nothing, naming the backend and what is missing: a build without the `gpu` feature,
+    /// no Vulkan loader or adapter, or a world with what the GPU backend does not step yet.
     pub fn set_backend(&mut self, backend: Backend) -> Result<(), Error> {
         match backend {
             Backend::Cpu => {
@@ -59,10 +86,29 @@ impl World {
                 {
                     self.gpu = None;
                 }
-                Ok(())
             }
-            Backend::Gpu => self.open_gpu(),
+            Backend::Gpu => self.open_gpu()?,
         }
+        self.params.backend = backend;
+        Ok(())
+    }
+
+    /// Errors, naming `what`, when the world steps on the GPU, which does not step `what`
+    /// yet: the refusal of a call that would add it.
+    pub(super) fn refuse_on_gpu(&self, what: &str) -> Result<(), Error> {
+        match self.backend() {
+            Backend::Gpu => Err(unsupported(what)),
+            Backend::Cpu => Ok(()),
+        }
+    }
+
+    /// Errors, naming the solver, when the world steps on the GPU and `kind` is a global
+    /// solver the GPU backend does not run.
+    pub(super) fn refuse_solver_on_gpu(&self, kind: SolverKind) -> Result<(), Error> {
+        if gpu_solver(kind) {
+            return Ok(());
+        }
+        self.refuse_on_gpu(&format!("the {} solver", kind.name()))
     }
 
     #[cfg(not(feature = "gpu"))]
@@ -92,16 +138,8 @@ impl World {
     /// Errors, naming the feature, when the world holds what the GPU backend does not step.
     #[cfg(feature = "gpu")]
     fn check_gpu_world(&self) -> Result<(), Error> {
-        let refuse = |what: &str| {
-            Err(gpu_error(&format!(
-                "does not support {what} yet; use the CPU backend"
-            )))
-        };
-        use crate::params::SolverKind;
-        if !matches!(
-            self.params.solver,
-            SolverKind::Chebyshev | SolverKind::Jacobi1
-        ) {
+        let refuse = |what: &str| Err(unsupported(what));
+        if !gpu_solver(self.params.solver) {
             return refuse(&format!("the {} solver", self.params.solver.name()));
         }
         if !self.bodies.is_empty() {
@@ -198,4 +236,64 @@ pub(crate) struct GpuSlot {
     context: Option<crate::gpu::GpuStepper>,
     /// Boundary particles the stepper was made with.
     boundary_len: usize,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::Params;
+
+    /// Worlds are made on the CPU unless their parameters say otherwise, and
+    /// [`World::set_backend`] keeps `params.backend` in step with the backend.
+    #[test]
+    fn the_cpu_is_the_default_and_params_follow_set_backend() {
+        assert_eq!(Params::default().backend, Backend::Cpu);
+        let mut world = World::new(Params::default()).unwrap();
+        assert_eq!(
+            (world.backend(), world.params().backend),
+            (Backend::Cpu, Backend::Cpu)
+        );
+        world.set_backend(Backend::Cpu).unwrap();
+        assert_eq!(world.params().backend, Backend::Cpu);
+        for backend in Backend::ALL {
+            assert_eq!(Backend::from_name(backend.name()), Some(backend));
+        }
+        assert_eq!(Backend::from_name("GPU"), None);
+    }
+
+    /// In a build without the `gpu` feature a world asked for on the GPU is not made, and a
+    /// world on the CPU asked to switch stays there, unchanged, its parameters too; the
+    /// error names the backend and the missing feature.
+    #[cfg(not(feature = "gpu"))]
+    #[test]
+    fn the_gpu_is_refused_where_the_build_lacks_it() {
+        let expected = Error::InvalidArgument {
+            field: "backend".into(),
+            message: "backend gpu: not available: this build of projfluid has no `gpu` feature"
+                .into(),
+        };
+        let gpu = Params {
+            backend: Backend::Gpu,
+            ..Params::default()
+        };
+        gpu.validate().unwrap();
+        assert_eq!(World::new(gpu.clone()).err(), Some(expected.clone()));
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(1)
+            .build()
+            .unwrap();
+        assert_eq!(World::with_pool(gpu, pool).err(), Some(expected.clone()));
+        let mut world = World::new(Params::default()).unwrap();
+        world
+            .add_fluid_block(crate::Vec3::zeros(), [2, 2, 2], crate::Vec3::zeros())
+            .unwrap();
+        let before = world.positions_hash();
+        assert_eq!(world.set_backend(Backend::Gpu), Err(expected));
+        assert_eq!(
+            (world.backend(), world.params().backend),
+            (Backend::Cpu, Backend::Cpu)
+        );
+        assert_eq!(world.positions_hash(), before);
+        world.step().unwrap();
+    }
 }

@@ -22,12 +22,14 @@ impl World {
     /// join the walls' (their Akinci volumes are computed with the walls'); a moving body's
     /// volumes are computed once over its own particles. Returns the body's id. Errors,
     /// leaving the world unchanged, on a bad spec (named field), a mesh that is far larger
-    /// than r or gives no particles, or the particle limit.
+    /// than r or gives no particles, the particle limit, or a world on the GPU backend,
+    /// which does not step bodies yet.
     ///
     /// A closed body makes room for itself (docs/method.md §2.7): fluid whose centre lies
     /// inside it is removed (see [`World::removed_count`]), and the fluid next to it is
     /// moved out of it and settled.
     pub fn add_body(&mut self, spec: BodySpec) -> Result<BodyId, Error> {
+        self.refuse_on_gpu("bodies")?;
         let r = self.params.particle_radius;
         let bounds = spec.mesh.bounds();
         let size = bounds.max - bounds.min;

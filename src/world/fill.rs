@@ -228,8 +228,10 @@ impl World {
     /// wall of boundary particles r apart adds on average along it, and costs nothing per
     /// boundary particle. Fluid outside every container counts as escaped. Errors, changing
     /// nothing, on a box that is not finite, narrower than two particle spacings along an
-    /// axis or wider than 10⁵·r, or on a shortage of memory.
+    /// axis or wider than 10⁵·r, on a shortage of memory, or on a world on the GPU backend,
+    /// which does not step such walls yet.
     pub fn add_container_field(&mut self, container: Aabb) -> Result<(), Error> {
+        self.refuse_on_gpu("container walls built as fields")?;
         self.check_container(&container)?;
         let oom = |_| Error::out_of_memory("the container");
         self.containers.try_reserve(1).map_err(oom)?;

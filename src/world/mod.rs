@@ -85,7 +85,8 @@ pub struct World {
 }
 
 impl World {
-    /// An empty world with the given parameters (validated).
+    /// An empty world with the given parameters (validated), on the backend
+    /// `params.backend` names (see [`World::with_pool`]).
     pub fn new(params: Params) -> Result<Self, Error> {
         params.validate()?;
         let pool = rayon::ThreadPoolBuilder::new()
@@ -100,9 +101,13 @@ impl World {
     /// An empty world with the given parameters (validated) that runs on `pool`, which the
     /// caller built (e.g. to join its threads after dropping the world, as the C API does).
     /// `params.threads` is kept as given; the pool's own size decides the parallelism.
+    /// With [`Backend::Gpu`] in `params.backend` the GPU is opened here, and the errors of
+    /// [`World::set_backend`] (no `gpu` feature, no Vulkan adapter, a solver or viscosity
+    /// the GPU backend does not run) are this function's: no world is made.
     pub fn with_pool(params: Params, pool: rayon::ThreadPool) -> Result<Self, Error> {
         params.validate()?;
-        Ok(Self {
+        let backend = params.backend;
+        let mut world = Self {
             constraint: DensityConstraint {
                 kernel: CubicKernel::new(params.support_radius()),
                 mass: params.particle_mass(),
@@ -138,7 +143,11 @@ impl World {
             #[cfg(feature = "gpu")]
             gpu: None,
             params,
-        })
+        };
+        if backend == Backend::Gpu {
+            world.set_backend(backend)?;
+        }
+        Ok(world)
     }
 
     /// The world's parameters.
@@ -146,7 +155,9 @@ impl World {
         &self.params
     }
 
-    /// Switches the global solver (and Chebyshev settings) between steps.
+    /// Switches the global solver (and Chebyshev settings) between steps. Errors, changing
+    /// nothing, on settings [`Params::validate`] rejects, and on a world on the GPU for a
+    /// solver the GPU backend does not run (it runs Chebyshev's and one Jacobi sweep).
     pub fn set_solver(
         &mut self,
         kind: SolverKind,
@@ -156,6 +167,7 @@ impl World {
         params.solver = kind;
         params.chebyshev = chebyshev;
         params.validate()?;
+        self.refuse_solver_on_gpu(kind)?;
         self.params = params;
         self.solver = linear_solver(kind);
         self.chebyshev = Chebyshev::new(chebyshev);

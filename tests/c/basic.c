@@ -57,6 +57,7 @@ int main(int argc, char **argv) {
     CHECK(params.gravity[1] == -9.81);
     CHECK(params.coarse_correction == 0);
     CHECK(params.kinematic_viscosity == 0.0 && params.no_slip == 1);
+    CHECK(params.backend == PF_BACKEND_CPU);
     params.threads = 2;
     OK(pf_params_validate(&params));
 
@@ -71,6 +72,7 @@ int main(int argc, char **argv) {
     CHECK(calm.coarse_correction == 0);
     CHECK(calm.kinematic_viscosity == params.kinematic_viscosity);
     CHECK(calm.no_slip == params.no_slip);
+    CHECK(calm.backend == params.backend);
     CHECK(calm.threads == 2 && calm.solver == params.solver);
     CHECK(calm.stiffness == params.stiffness && calm.dt_max == params.dt_max);
     OK(pf_params_validate(&calm));
@@ -84,6 +86,7 @@ int main(int argc, char **argv) {
     CHECK(memcmp(&back.particle_radius, &params.particle_radius, sizeof(double)) == 0);
     CHECK(back.threads == 2 && back.max_outer_iterations == params.max_outer_iterations);
     CHECK(back.coarse_correction == 0);
+    CHECK(back.backend == PF_BACKEND_CPU);
 
     /* The coarse correction turned on is kept by the world. */
     PfParams coarse_on = params;

@@ -53,6 +53,7 @@ static void bad_params(PfParams p, const char *field) {
     CHECK(calm.coarse_correction == p.coarse_correction);
     CHECK(memcmp(&calm.kinematic_viscosity, &p.kinematic_viscosity, sizeof(double)) == 0);
     CHECK(calm.no_slip == p.no_slip);
+    CHECK(calm.backend == p.backend);
     rejected += 3;
 }
 
@@ -131,6 +132,29 @@ int main(void) {
     p = params;
     p.no_slip = 2;
     bad_params(p, "params->no_slip must be 0 or 1, got 2");
+    p = params;
+    p.backend = 2;
+    bad_params(p, "params->backend must be PF_BACKEND_CPU (0) or PF_BACKEND_GPU (1), got 2");
+    p = params;
+    p.backend = UINT32_MAX;
+    bad_params(p, "params->backend must be PF_BACKEND_CPU (0) or PF_BACKEND_GPU (1), got 4294967295");
+
+    /* The GPU backend is not in this build (the tests' library is built without the `gpu`
+       feature): the value is valid, but no world is made, and the message names the backend
+       and the missing feature. pf_world_create_from_scene refuses a scene for the GPU the
+       same way (src/ffi/scene.rs). */
+    p = params;
+    p.backend = PF_BACKEND_GPU;
+    OK(pf_params_validate(&p));
+    {
+        PfWorld *none = (PfWorld *)&p; /* must be overwritten with NULL */
+        EXPECT(PF_ERROR_INVALID_ARGUMENT, pf_world_create(&p, &none));
+        CHECK(strcmp(pf_last_error_message(),
+                     "pf_world_create: backend gpu: not available: this build of projfluid has "
+                     "no `gpu` feature") == 0);
+        CHECK(none == NULL);
+        rejected++;
+    }
 
     /* --- NULL pointers outside a world. --- */
     PfWorld *w = NULL;

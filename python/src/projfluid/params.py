@@ -53,6 +53,10 @@ class ProjectionWeight(enum.IntEnum):
 
 EnumLike = int | str
 
+#: ``Params.backend``'s choices, indexed by their ``PfParams.backend`` value
+#: (``PF_BACKEND_CPU``, ``PF_BACKEND_GPU``).
+BACKENDS = ("cpu", "gpu")
+
 _C_DEFAULTS = PfParams()
 check(lib.pf_params_default(byref(_C_DEFAULTS)))
 
@@ -87,7 +91,10 @@ class Params:
     :class:`~projfluid.errors.InvalidArgumentError` carrying the C status and message, which
     names the field (e.g. ``pf_params_validate: chebyshev_rho must be in [0, 1), got 1.5``).
     A value C cannot represent at all (a negative thread count, an unknown solver name)
-    raises :class:`ValueError`. Note that, as in C, ``displacement_tolerance`` defaults to
+    raises :class:`ValueError`; so does a ``backend`` other than ``"cpu"`` and ``"gpu"``.
+    ``backend="gpu"`` is checked when a world is made: a library without the GPU backend,
+    or a machine without a Vulkan adapter, makes :class:`~projfluid.World` raise
+    :class:`~projfluid.errors.InvalidArgumentError` with the library's reason. Note that, as in C, ``displacement_tolerance`` defaults to
     3e-3 times the *default* particle radius: scale it yourself with another radius.
     """
 
@@ -155,6 +162,11 @@ class Params:
     """Under the physical viscosity, the walls, static obstacles and static bodies hold the
     fluid with no slip (True, the default) or let it slide (False, free slip). Moving bodies
     and walls built as fields let it slide either way."""
+    backend: str = BACKENDS[_C_DEFAULTS.backend]
+    """Where the world's steps run: ``"cpu"`` (the default, double precision) or ``"gpu"``
+    (single precision on a Vulkan device, in a library built with the ``gpu`` feature). A
+    world on the GPU refuses bodies, emitters, walls built as fields, further materials, the
+    physical viscosity and solvers other than ``chebyshev`` and ``jacobi1``."""
 
     def __post_init__(self) -> None:
         for field in dataclasses.fields(self):
@@ -180,13 +192,18 @@ class Params:
         c = PfParams()
         for field in dataclasses.fields(self):
             value = _normalized(field.name, getattr(self, field.name))
+            if field.name == "backend":
+                value = BACKENDS.index(value)
             setattr(c, field.name, int(value) if field.name in _INTEGERS else value)
         return c
 
     @classmethod
     def from_c(cls, c: PfParams) -> Params:
         """The settings held in a ``PfParams`` struct (validated)."""
-        return cls(**{field.name: getattr(c, field.name) for field in dataclasses.fields(cls)})
+        settings = {field.name: getattr(c, field.name) for field in dataclasses.fields(cls)}
+        if c.backend < len(BACKENDS):
+            settings["backend"] = BACKENDS[c.backend]
+        return cls(**settings)
 
 
 _SWITCHES = ("chebyshev_auto_rho", "coarse_correction", "no_slip")
@@ -198,6 +215,8 @@ def _normalized(name: str, value: Any) -> Any:
     the field when ``PfParams`` cannot hold it."""
     if name in _ENUMS:
         return _to_enum(_ENUMS[name], value, name)
+    if name == "backend":
+        return _backend(value)
     if name == "gravity":
         return _vector3(value, name)
     if name in _SWITCHES:
@@ -205,6 +224,14 @@ def _normalized(name: str, value: Any) -> Any:
     if name in _UNSIGNED:
         return _unsigned32(value, name)
     return _real(value, name)
+
+
+def _backend(value: Any) -> str:
+    """``value`` as one of :data:`BACKENDS`, or a :class:`ValueError` naming them."""
+    if isinstance(value, str) and value.lower() in BACKENDS:
+        return value.lower()
+    choices = " or ".join(repr(b) for b in BACKENDS)
+    raise ValueError(f"backend must be {choices}, got {value!r}")
 
 
 def _real(value: Any, name: str) -> float:

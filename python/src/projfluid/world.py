@@ -46,7 +46,10 @@ class World(BodiesMixin, FlowMixin):
     """
 
     def __init__(self, params: Params | None = None) -> None:
-        """Creates an empty world with ``params`` (the defaults when None)."""
+        """Creates an empty world with ``params`` (the defaults when None) on the backend
+        ``params.backend`` names. ``backend="gpu"`` where the library has no GPU backend or
+        the machine no Vulkan adapter raises
+        :class:`~projfluid.errors.InvalidArgumentError` with the library's reason."""
         c_params = (params if params is not None else Params()).to_c()
         handle = c_void_p()
         check(lib.pf_world_create(byref(c_params), byref(handle)))

@@ -51,7 +51,7 @@ fn every_key_is_read() {
                        "max_iterations": 50, "min_iterations": 2, "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
             "viscosity": 0.02, "kinematic_viscosity": 1e-4, "no_slip": false,
-            "threads": 2, "duration": 3,
+            "threads": 2, "backend": "gpu", "duration": 3,
             "output": {"dir": "frames", "every": 5, "fps": 25}
         }"#;
     let s = Scene::from_json(text).unwrap();
@@ -83,6 +83,7 @@ fn every_key_is_read() {
     assert_eq!((p.viscosity, p.threads), (0.02, 2));
     assert_eq!(p.kinematic_viscosity, 1e-4);
     assert!(!p.no_slip);
+    assert_eq!(p.backend, crate::Backend::Gpu);
     assert_eq!(s.containers[0].layers, 2);
     assert_eq!(
         s.containers[0].walls,
@@ -110,6 +111,7 @@ fn round_trip_through_json() {
     custom.params.coarse_correction = false;
     custom.params.kinematic_viscosity = 1.0 / 3.0 * 1e-3;
     custom.params.no_slip = false;
+    custom.params.backend = crate::Backend::Gpu;
     custom.output.dir = Some(PathBuf::from("out [1]/frames"));
     custom.description = "quotes \" and [brackets]".to_string();
     scenes.push(custom);
@@ -281,6 +283,51 @@ fn kinematic_viscosity_and_no_slip_are_read_written_and_checked() {
     assert_eq!(
         bad("\"kinematic_viscosity\": -1e-6"),
         "kinematic_viscosity must be finite and not negative (m²/s; 0 turns it off), got -0.000001"
+    );
+}
+
+/// `backend` is `"cpu"` unless a scene sets it; a scene written out keeps it; a value other
+/// than `"cpu"` or `"gpu"` is refused naming the key and the choices. A scene for the GPU
+/// reads and validates in any build: its world is refused where it is made, naming the
+/// backend and what is missing.
+#[test]
+fn backend_is_read_written_and_checked() {
+    use crate::Backend;
+    assert_eq!(Scene::from_json(GOOD).unwrap().params.backend, Backend::Cpu);
+    let json = Scene::from_json(GOOD).unwrap().to_json();
+    assert!(json.contains("\"backend\": \"cpu\""), "{json}");
+    let with = |value: &str| {
+        GOOD.replacen(
+            "\"fluid_blocks\"",
+            &format!("\"backend\": {value}, \"fluid_blocks\""),
+            1,
+        )
+    };
+    let scene = Scene::from_json(&with("\"gpu\"")).unwrap();
+    assert_eq!(scene.params.backend, Backend::Gpu);
+    scene.validate().unwrap();
+    let json = scene.to_json();
+    assert!(json.contains("\"backend\": \"gpu\""), "{json}");
+    let again = Scene::from_json(&json).unwrap();
+    assert_eq!(again.params.backend, Backend::Gpu);
+    assert_eq!(again, scene);
+    assert_eq!(
+        Scene::from_json(&with("\"cpu\"")).unwrap().params.backend,
+        Backend::Cpu
+    );
+    assert_names(
+        &message(Scene::from_json(&with("\"tpu\""))),
+        &["backend", "tpu", "`cpu`", "`gpu`"],
+    );
+    assert_names(
+        &message(Scene::from_json(&with("\"GPU\""))),
+        &["backend", "GPU", "`cpu`", "`gpu`"],
+    );
+    assert_names(&message(Scene::from_json(&with("1"))), &["backend", "1"]);
+    #[cfg(not(feature = "gpu"))]
+    assert_eq!(
+        scene.build_world().err().map(|e| e.to_string()),
+        Some("backend gpu: not available: this build of projfluid has no `gpu` feature".into())
     );
 }
 

@@ -14,6 +14,7 @@ use crate::frames::{FrameFormat, Frames};
 use crate::probes::ProbeLog;
 use crate::solver_parser;
 use clap::Args;
+use clap::builder::{PossibleValuesParser, TypedValueParser};
 use options::validate_naming_options;
 use print::print_summary;
 use progress::Progress;
@@ -59,10 +60,11 @@ pub(crate) struct RunArgs {
     #[command(flatten)]
     params: ParamOptions,
     /// Where the steps run: `cpu`, or `gpu` (Vulkan; in a build with the `gpu` feature:
-    /// `cargo run --release --features gpu -- run …`). There is no fallback: a GPU that cannot
-    /// be had, or a scene it does not step yet, is an error naming what is missing.
-    #[arg(long, value_name = "cpu|gpu", default_value = "cpu", value_parser = ["cpu", "gpu"])]
-    backend: String,
+    /// `cargo run --release --features gpu -- run …`) [default: the scene's `backend`, else
+    /// cpu]. There is no fallback: a GPU that cannot be had, or a scene it does not step yet,
+    /// is an error naming what is missing.
+    #[arg(long, value_name = "cpu|gpu", value_parser = backend_parser())]
+    backend: Option<Backend>,
     /// Write data frames (frame_00000.vtp, .vtk or .ply, …) into this directory, created if
     /// missing.
     #[arg(long, value_name = "DIR")]
@@ -115,9 +117,11 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
             .build_world()
             .map_err(|e| Failure::Input(e.to_string()))?,
     };
-    if args.backend == "gpu" {
+    // A fresh world is made on the scene's backend; a resumed one on its checkpoint's,
+    // which --backend may change.
+    if world.backend() != scene.params.backend {
         world
-            .set_backend(Backend::Gpu)
+            .set_backend(scene.params.backend)
             .map_err(|e| Failure::Input(e.to_string()))?;
     }
     if args.resume.is_some() && args.steps.is_none() && args.duration.is_none() {
@@ -212,11 +216,12 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
         }
     };
     eprintln!(
-        "{}: {} particles{not_created}, {} boundary particles, {} solver, {goal}",
+        "{}: {} particles{not_created}, {} boundary particles, {} solver on the {}, {goal}",
         scene.name,
         world.fluid_count(),
         world.boundary_count(),
-        scene.params.solver.name()
+        scene.params.solver.name(),
+        world.backend().name().to_uppercase()
     );
     warn_about_loose_pressure_readings(&scene, &world);
     let mut progress = Progress::new(target);
@@ -277,10 +282,20 @@ pub(crate) fn run(args: &RunArgs) -> Result<(), Failure> {
     Ok(())
 }
 
+/// `--backend`'s values, `cpu` and `gpu`.
+fn backend_parser() -> impl TypedValueParser<Value = Backend> {
+    PossibleValuesParser::new(Backend::NAMES).try_map(|name| {
+        Backend::from_name(&name).ok_or_else(|| format!("unknown backend `{name}`"))
+    })
+}
+
 /// Applies the command-line overrides to `scene` and checks the result; errors name the option.
 fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failure> {
     if let Some(s) = args.solver {
         scene.params.solver = s;
+    }
+    if let Some(b) = args.backend {
+        scene.params.backend = b;
     }
     args.params.apply(scene);
     if let Some(every) = args.every {

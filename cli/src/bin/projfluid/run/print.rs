@@ -21,6 +21,14 @@ pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
                 s.tau
             )
         }),
+        ("backend", {
+            let precision = if s.backend == "gpu" {
+                "single"
+            } else {
+                "double"
+            };
+            format!("{} ({precision} precision)", s.backend)
+        }),
         ("kinematic viscosity", {
             let walls = if s.no_slip { "no-slip" } else { "free-slip" };
             if s.kinematic_viscosity > 0.0 {

@@ -33,10 +33,7 @@ impl Backend {
     /// The backend's name, as `"cpu"` or `"gpu"` (the scene key `backend`, the CLI's
     /// `--backend`).
     pub fn name(self) -> &'static str {
-        match self {
-            Backend::Cpu => "cpu",
-            Backend::Gpu => "gpu",
-        }
+        Self::NAMES[self as usize]
     }
 
     /// Parses a backend's name (see [`Backend::name`]).

@@ -1,8 +1,9 @@
 //! Several liquids in one world (docs/method.md §14): a material of the world's own density
-//! changes nothing, two layers at rest keep their order and carry a two-slope hydrostatic
-//! pressure, a heavy blob sinks through water, each particle reads its own material's
+//! changes nothing, a heavy blob sinks through water, each particle reads its own material's
 //! density, the result does not depend on the thread count, and bad materials are refused
-//! without changing the world.
+//! without changing the world. Two liquids at rest against the two-slope hydrostatic profile,
+//! and the heavier one put on top overturning, are tested with `projfluid validate
+//! two-layers`' module (cli/tests/validation.rs).
 
 use projfluid::boundary::Aabb;
 use projfluid::{Material, MaterialId, Params, Vec3, World};
@@ -102,16 +103,18 @@ fn a_material_of_the_worlds_density_changes_nothing() {
     );
 }
 
-/// A blob three times as dense as water sinks through it; one of water's density settles
-/// with the water around it. The heavy blob's particles weigh three times as much.
+/// A blob half again as dense as water sinks through it, most of the way to the floor
+/// within 1 s (0.32 m of the 0.57 m; the projections yield to each particle's inertia,
+/// docs/method.md §14); one of water's density settles with the water around it. The heavy
+/// blob's particles weigh half again as much.
 #[test]
 fn a_heavy_blob_sinks_and_a_neutral_one_stays() {
-    let mut heavy = blob_world(3000.0, 0);
+    let mut heavy = blob_world(1500.0, 0);
     let mut neutral = blob_world(1000.0, 0);
     let (h0, n0) = (mean_height(&heavy, 1), mean_height(&neutral, 1));
     let (e_heavy, e_neutral) = (heavy.potential_energy(), neutral.potential_energy());
     let mass = heavy.particle_mass();
-    let extra = 2.0 * mass * 9.81 * 64.0 * h0;
+    let extra = 0.5 * mass * 9.81 * 64.0 * h0;
     assert!(
         ((e_heavy - e_neutral) / extra - 1.0).abs() < 1e-9,
         "potential energy {e_heavy} J against {e_neutral} J + {extra} J"
@@ -120,7 +123,7 @@ fn a_heavy_blob_sinks_and_a_neutral_one_stays() {
     neutral.advance(1.0).unwrap();
     let (sunk, moved) = (h0 - mean_height(&heavy, 1), n0 - mean_height(&neutral, 1));
     assert!(
-        sunk > moved + 0.08,
+        sunk > 0.2,
         "the heavy blob sank {sunk} m in 1 s, the neutral one {moved} m"
     );
     assert!(moved.abs() < 0.05, "the neutral blob moved {moved} m");
@@ -137,105 +140,6 @@ fn two_liquids_are_deterministic_across_thread_counts() {
         two.step().unwrap();
     }
     assert_eq!(one.positions_hash(), two.positions_hash());
-}
-
-/// Oil (800 kg/m³) over water at rest: the layers keep their order (within two spacings of
-/// the interface), each reads its own
-/// density, and the constraints carry a pressure that grows with depth at 0.8·ρ0·g in the
-/// oil and ρ0·g in the water (within 5 %).
-#[test]
-fn oil_over_water_keeps_its_layers_and_two_hydrostatic_slopes() {
-    let count = [10, 16, 10];
-    let params = Params::default().calm();
-    let (r, d) = (params.particle_radius, params.spacing());
-    let (mut world, tank, gap) = tank(params, count);
-    let (water, oil_points) = split_lattice(count, d, gap, |[_, j, _]| j >= 8);
-    world.add_fluid_particles(&water, None).unwrap();
-    let oil = world
-        .add_material(Material {
-            rest_density: 800.0,
-        })
-        .unwrap();
-    world.set_fluid_material(oil).unwrap();
-    world.add_fluid_particles(&oil_points, None).unwrap();
-    let interface = gap + 7.5 * d;
-    world.relax(2.0, 4.0).unwrap();
-    world.advance(0.5).unwrap();
-    let (x, m) = (world.positions(), world.particle_materials());
-    let lowest_oil = x
-        .iter()
-        .zip(&m)
-        .filter(|(_, k)| **k == oil)
-        .map(|(p, _)| p.y);
-    let highest_water = x.iter().zip(&m).filter(|(_, k)| **k == 0).map(|(p, _)| p.y);
-    let lowest_oil = lowest_oil.fold(f64::MAX, f64::min);
-    let highest_water = highest_water.fold(f64::MIN, f64::max);
-    // Particles beside the walls trade places across the interface, within two spacings.
-    assert!(
-        lowest_oil > interface - 2.0 * d && highest_water < interface + 2.0 * d,
-        "oil down to {lowest_oil} m, water up to {highest_water} m, interface at {interface} m"
-    );
-    // Densities in each material's own terms: the mean over the particles away from the
-    // free surface is that material's rest density.
-    let densities = world.densities();
-    let top = x.iter().map(|p| p.y).fold(f64::MIN, f64::max);
-    for (material, rest) in [(0, 1000.0), (oil, 800.0)] {
-        let inner: Vec<f64> = (0..x.len())
-            .filter(|&i| m[i] == material && x[i].y < top - 4.0 * r)
-            .map(|i| densities[i])
-            .collect();
-        let mean = inner.iter().sum::<f64>() / inner.len() as f64;
-        assert!(
-            (mean / rest - 1.0).abs() < 0.01,
-            "material {material}: {mean} kg/m³"
-        );
-    }
-    // The pressure, read with a tight solve (as the hydrostatic validation reads it) and
-    // averaged over layers one support radius from the side walls.
-    world.set_density_tolerance(0.0).unwrap();
-    world.set_displacement_tolerance(1e-5 * r).unwrap();
-    let h = world.params().support_radius();
-    let mut layers = vec![(0.0, 0.0, 0usize); count[1] + 4];
-    let start = world.time();
-    while world.time() < start + 0.2 {
-        world.step().unwrap();
-        for (p, pressure) in world.constraint_pressures().samples {
-            let inner = [(p.x, tank.max.x), (p.z, tank.max.z)];
-            if inner.iter().all(|&(c, max)| c > h && c < max - h) {
-                let layer = &mut layers[((p.y / d) as usize).min(count[1] + 3)];
-                *layer = (layer.0 + p.y, layer.1 + pressure, layer.2 + 1);
-            }
-        }
-    }
-    let means: Vec<(f64, f64)> = layers
-        .iter()
-        .filter(|l| l.2 > 0)
-        .map(|l| (l.0 / l.2 as f64, l.1 / l.2 as f64))
-        .collect();
-    // −dp/dy by least squares over the layers between heights `low` and `high` (m).
-    let slope = |low: f64, high: f64| {
-        let points: Vec<&(f64, f64)> = means
-            .iter()
-            .filter(|(y, _)| *y > low && *y < high)
-            .collect();
-        assert!(points.len() >= 3, "{points:?}");
-        let n = points.len() as f64;
-        let (my, mp) = points
-            .iter()
-            .fold((0.0, 0.0), |a, (y, p)| (a.0 + y / n, a.1 + p / n));
-        let (sxy, sxx) = points.iter().fold((0.0, 0.0), |a, (y, p)| {
-            (a.0 + (y - my) * (p - mp), a.1 + (y - my) * (y - my))
-        });
-        -sxy / sxx
-    };
-    let g = 9.81;
-    let water_slope = slope(h, interface - 0.5 * h) / (1000.0 * g);
-    let oil_slope = slope(interface + 0.5 * h, top - h) / (800.0 * g);
-    assert!(
-        (water_slope - 1.0).abs() < 0.03,
-        "water: {water_slope} ρ0·g"
-    );
-    assert!((oil_slope - 1.0).abs() < 0.03, "oil: {oil_slope} ρ_oil·g");
 }
 
 /// Bad materials and material ids are refused, naming the field, and change nothing.

@@ -1,14 +1,16 @@
 //! Validation against experiment and analytic solutions: the Martin & Moyce (1952) column
 //! collapse ([`martin_moyce`]), the MARIN dam break past a box (Kleefsman et al. 2005,
-//! [`kleefsman`]), a tank of water at rest ([`hydrostatic`]) and viscous flow down a duct
-//! ([`poiseuille`]). The CLI's
+//! [`kleefsman`]), a tank of water at rest ([`hydrostatic`]), viscous flow down a duct
+//! ([`poiseuille`]) and two liquids at rest and overturning ([`two_layers`]). The CLI's
 //! `projfluid validate` prints and plots what these modules compute; the tests assert on it.
 
+mod fit;
 pub mod hydrostatic;
 pub mod kleefsman;
 pub mod martin_moyce;
 pub mod poiseuille;
 pub mod reference;
+pub mod two_layers;
 
 use projfluid::Error;
 use std::path::Path;

@@ -6,7 +6,7 @@ mod support;
 use projfluid::SolverKind;
 use projfluid_lab::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, poiseuille};
+use projfluid_lab::validation::{hydrostatic, poiseuille, two_layers};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use support::{projfluid, projfluid_ok};
@@ -211,6 +211,77 @@ fn duct_flow_takes_the_analytic_profile_at_two_viscosities() {
     }
 }
 
+/// Two liquids (`projfluid validate two-layers`' defaults): oil of 800 kg/m³ over water at
+/// rest keeps its layers (within two spacings of the interface), each liquid reads its own
+/// density within 1 %, and the pressure follows the two-slope hydrostatic profile within 3 %
+/// RMS of the bottom pressure, each slope within 7 % (the estimate bends near the surface
+/// and the interface); water put over the oil overturns within 3 s, losing no particle.
+#[test]
+fn two_liquids_keep_two_hydrostatic_slopes_and_the_heavier_on_top_overturns() {
+    let setup = two_layers::Setup::default();
+    let report = two_layers::simulate(&setup).unwrap();
+    let (rest, over) = (&report.rest, &report.overturn);
+    let d = 2.0 * setup.particle_radius;
+    assert!(
+        rest.lowest_light > -2.0 * d && rest.highest_water < 2.0 * d,
+        "lighter down to {} m, water up to {} m from the interface",
+        rest.lowest_light,
+        rest.highest_water
+    );
+    let (water, lighter) = rest.densities;
+    assert!(
+        (water / 1000.0 - 1.0).abs() < 0.01 && (lighter / setup.light_density - 1.0).abs() < 0.01,
+        "densities {water} and {lighter} kg/m³"
+    );
+    assert!(
+        rest.profile_error < 0.03,
+        "the pressure departs from the two-slope profile by {:.1} % RMS: {:?}",
+        100.0 * rest.profile_error,
+        rest.layers
+    );
+    let (water_slope, light_slope) = rest.slopes;
+    assert!(
+        (water_slope - 1.0).abs() < 0.07 && (light_slope - 1.0).abs() < 0.07,
+        "slopes {water_slope} ρ_w·g and {light_slope} ρ_l·g"
+    );
+    let overturned = over.overturned_at.unwrap_or(f64::INFINITY);
+    assert!(overturned < 3.0, "{:?}", over.heights);
+    let &(_, water_end, light_end) = over.heights.last().unwrap();
+    assert!(
+        water_end < light_end - 0.05,
+        "in the end the water's mean height is {water_end} m, the lighter's {light_end} m"
+    );
+    assert_eq!(over.lost, 0);
+}
+
+#[test]
+fn cli_two_layers_writes_its_table_csvs_and_charts() {
+    let dir = scratch("cli_two_layers");
+    let stdout = projfluid_ok(&[
+        "validate",
+        "two-layers",
+        "--resolution",
+        "6",
+        "--duration",
+        "0.2",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("two liquids"), "{stdout}");
+    assert!(stdout.contains("two-slope hydrostatic profile"), "{stdout}");
+    let pressure = std::fs::read_to_string(dir.join("two_layers_pressure.csv")).unwrap();
+    assert!(pressure.lines().count() > 6, "{pressure}");
+    let heights = std::fs::read_to_string(dir.join("two_layers_overturn.csv")).unwrap();
+    // A header and the start, then one row every 0.05 s.
+    assert_eq!(heights.lines().count(), 1 + 1 + 4, "{heights}");
+    for png in ["two_layers_pressure.png", "two_layers_overturn.png"] {
+        let bytes = std::fs::read(dir.join(png)).unwrap();
+        assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    }
+}
+
 /// `name` under this file's directory for test files, emptied.
 fn scratch(name: &str) -> PathBuf {
     support::scratch("validation", name)
@@ -256,7 +327,7 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 15] = [
+    let cases: [&[&str]; 17] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
         &[
             "validate",
@@ -346,6 +417,22 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
             "poiseuille",
             "--walls",
             "field",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "two-layers",
+            "--light-density",
+            "1200",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "two-layers",
+            "--resolution",
+            "3",
             "--out",
             out_dir,
         ],

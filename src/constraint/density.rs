@@ -234,3 +234,19 @@ impl DensityConstraint {
         }
     }
 }
+
+/// Divides every fluid particle's projection weight w_j in `weights` by its mass ratio
+/// m_j/m, m_j = `mass_of(j)` (kg) being its mass and m = `mass` (kg) the world's particle
+/// mass: each projection then moves its members in inverse proportion to their masses, as a
+/// projection in the metric of the masses does, so that a heavier liquid yields less to the
+/// same constraint than a lighter one within every outer iteration (docs/method.md §14).
+pub(crate) fn weigh_by_inertia(
+    weights: &mut [f64],
+    mass: f64,
+    mass_of: impl Fn(usize) -> f64 + Sync,
+) {
+    weights
+        .par_iter_mut()
+        .enumerate()
+        .for_each(|(j, w)| *w *= mass / mass_of(j));
+}

@@ -12,6 +12,7 @@ mod gather;
 mod projection;
 mod stencil;
 
+pub(crate) use density::weigh_by_inertia;
 pub use gather::Corrections;
 pub use projection::Projection;
 

@@ -9,7 +9,7 @@
 use super::search::Prediction;
 use super::{StepBuffers, coarse, couple, warm_start};
 use crate::boundary::Boundary;
-use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection};
+use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection, weigh_by_inertia};
 use crate::fluid::Fluid;
 use crate::params::{Params, SolverKind};
 use crate::solver::{Chebyshev, GlobalSolver, Sweep};
@@ -85,16 +85,19 @@ pub(super) fn iterate(
         warm,
         coarse,
     } = it;
-    // The system matrix of formulation F1, frozen for the step, with every slot's mass.
+    // The system matrix of formulation F1, frozen for the step. Every row is written for the
+    // world's particle mass m: a material's mass ratio scales a row's inertia and constraint
+    // terms alike, so it cancels here and acts through the projections' weights below
+    // (docs/method.md §14).
+    let mass = constraint.mass;
     let dt2k = dt * dt * params.stiffness;
     let lists = &b.fluid_lists;
-    let masses = &b.masses;
     b.system.diagonal.resize(lists.len(), 0.0);
     b.system
         .diagonal
         .par_iter_mut()
         .enumerate()
-        .for_each(|(j, a)| *a = masses[j] + dt2k * constraint.membership(lists, j));
+        .for_each(|(j, a)| *a = mass + dt2k * constraint.membership(lists, j));
     solver.prepare(&b.system)?;
 
     // The fluid holds one support per particle once a step with the warm start recorded
@@ -107,6 +110,10 @@ pub(super) fn iterate(
     }
     b.previous.clone_from(&b.current);
     constraint.weights(&b.fluid_lists, &mut b.weights);
+    if b.masses.iter().any(|&m| m != mass) {
+        let masses = &b.masses;
+        weigh_by_inertia(&mut b.weights, mass, |j| masses[j]);
+    }
     let nb = Neighborhood {
         fluid: &b.fluid_lists,
         boundary: &b.boundary_lists,
@@ -210,9 +217,9 @@ pub(super) fn iterate(
             });
         }
         let (projections, corrections) = (&b.projections, &b.corrections);
-        let (current, masses) = (&b.current, &b.masses);
+        let current = &b.current;
         let predicted = Prediction::new(fluid, Some(&b.order), dt, gravity);
-        // b_j = m_j s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
+        // b_j = m s_j + Δt²k Σ_{i: j∈N̄_i} P_{i,j}, with P_{i,j} = X_j + correction,
         // for the particles of chunk `chunk`.
         let fill_rhs = |chunk: usize, rhs: &mut [Vec3]| {
             let first = chunk * CHUNK;
@@ -220,7 +227,7 @@ pub(super) fn iterate(
             for (j, rhs) in (first..).zip(rhs) {
                 let members = constraint.membership(lists, j);
                 let scale = constraint.correction_scale(lists, j);
-                *rhs = predicted.at(j) * masses[j] + (current[j] * members + *rhs * scale) * dt2k;
+                *rhs = predicted.at(j) * mass + (current[j] * members + *rhs * scale) * dt2k;
             }
         };
         if single_sweep {

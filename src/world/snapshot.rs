@@ -5,7 +5,7 @@
 use super::World;
 use crate::Vec3;
 use crate::boundary::{Aabb, WallField, akinci_volumes};
-use crate::constraint::Neighborhood;
+use crate::constraint::{Neighborhood, weigh_by_inertia};
 use crate::neighbors::{CellTable, NeighborLists, PointsByComponent, UniformGrid};
 use std::collections::TryReserveError;
 
@@ -273,6 +273,15 @@ impl World {
         snapshot.boundary_near(x, h, &mut boundary_lists);
         let mut weights = Vec::new();
         self.constraint.weights(&fluid_lists, &mut weights);
+        // The weights of the step's projections (docs/method.md §14).
+        let ratios = &self.materials.mass_ratios;
+        if ratios.iter().any(|&r| r != 1.0) {
+            let (order, materials) = (&snapshot.fluid_order, &self.fluid.materials);
+            let mass = self.constraint.mass;
+            weigh_by_inertia(&mut weights, mass, |k| {
+                mass * ratios[materials[order[k] as usize] as usize]
+            });
+        }
         read(&Neighborhood {
             fluid: &fluid_lists,
             boundary: &boundary_lists,

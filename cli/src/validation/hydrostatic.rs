@@ -23,14 +23,13 @@
 //! Submodules hold the setup ([`Setup`]) and the report ([`Report::text`], [`write_report`]);
 //! the tank runs and is measured in [`simulate`].
 
-mod fit;
 mod report;
 mod setup;
 
 pub use report::{ReportFiles, write_report};
 pub use setup::Setup;
 
-use fit::{correlation, least_squares_slope};
+use super::fit::{correlation, least_squares_slope};
 use projfluid::boundary::Aabb;
 use projfluid::{Error, Vec3, World};
 

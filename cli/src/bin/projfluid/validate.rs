@@ -1,14 +1,14 @@
 //! `projfluid validate`: the Martin & Moyce dam break against the 1952 measurements, the
 //! MARIN dam break past a box against Kleefsman et al. (2005), a tank at rest against
-//! hydrostatics, and viscous flow down a duct against its analytic profile. Prints a table
-//! and writes CSV and PNG files.
+//! hydrostatics, viscous flow down a duct against its analytic profile, and two liquids at
+//! rest and overturning. Prints a table and writes CSV and PNG files.
 
 use crate::{Failure, solver_parser};
 use clap::{Args, Subcommand};
 use projfluid::scene::ContainerWalls;
 use projfluid::{Error, SolverKind};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce, poiseuille};
+use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce, poiseuille, two_layers};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -27,6 +27,9 @@ pub(crate) enum ValidateCommand {
     /// Viscous flow down a duct (Poiseuille flow driven by the weight): the speed across the
     /// duct against the analytic profile, at each viscosity.
     Poiseuille(PoiseuilleArgs),
+    /// Two liquids: a lighter one over water at rest (the pressure against the two-slope
+    /// hydrostatic profile), and water over the lighter one, which overturns.
+    TwoLayers(TwoLayersArgs),
 }
 
 /// Options every validation takes.
@@ -198,6 +201,32 @@ pub(crate) struct PoiseuilleArgs {
     common: CommonArgs,
 }
 
+/// Options of `projfluid validate two-layers`.
+#[derive(Args)]
+pub(crate) struct TwoLayersArgs {
+    /// Particles across the tank at rest (6–40; see docs/validation.md for both tanks).
+    #[arg(long, value_name = "N", default_value_t = 10)]
+    resolution: usize,
+    /// Rest density of the lighter liquid, in kg/m³ (the other is water, 1000).
+    #[arg(
+        long,
+        value_name = "KG_M3",
+        default_value_t = 800.0,
+        allow_negative_numbers = true
+    )]
+    light_density: f64,
+    /// Longest simulated time of the overturning run, in seconds.
+    #[arg(
+        long,
+        value_name = "SECONDS",
+        default_value_t = 4.0,
+        allow_negative_numbers = true
+    )]
+    duration: f64,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
 /// `projfluid validate …`.
 pub(crate) fn validate(command: &ValidateCommand) -> Result<(), Failure> {
     match command {
@@ -205,6 +234,7 @@ pub(crate) fn validate(command: &ValidateCommand) -> Result<(), Failure> {
         ValidateCommand::Kleefsman(args) => kleefsman(args),
         ValidateCommand::Hydrostatic(args) => hydrostatic(args),
         ValidateCommand::Poiseuille(args) => poiseuille(args),
+        ValidateCommand::TwoLayers(args) => two_layers(args),
     }
 }
 
@@ -429,6 +459,37 @@ fn poiseuille(args: &PoiseuilleArgs) -> Result<(), Failure> {
         report.text(),
         files.profile_csv.display(),
         files.profile_png.display()
+    );
+    print(&text)
+}
+
+fn two_layers(args: &TwoLayersArgs) -> Result<(), Failure> {
+    if args.common.walls() == ContainerWalls::Field {
+        return Err(Failure::Input(
+            "--walls field: the two-liquid tanks are built with particle walls; use --walls \
+             particles"
+                .into(),
+        ));
+    }
+    let setup = two_layers::Setup {
+        across: args.resolution,
+        light_density: args.light_density,
+        overturn_duration: args.duration,
+        solver: args.common.solver,
+        threads: args.common.threads,
+        ..two_layers::Setup::default()
+    };
+    setup.validate().map_err(option_error)?;
+    create_dir(&args.common.out)?;
+    let report = two_layers::simulate(&setup).map_err(runtime)?;
+    let files = two_layers::write_report(&args.common.out, &report).map_err(runtime)?;
+    let text = format!(
+        "{}\nwrote {}, {}, {}, {}\n",
+        report.text(),
+        files.pressure_csv.display(),
+        files.pressure_png.display(),
+        files.overturn_csv.display(),
+        files.overturn_png.display()
     );
     print(&text)
 }

@@ -1,7 +1,7 @@
 //! Fits to the pressure profile: the least-squares slope and the Pearson correlation.
 
 /// Pearson correlation of the pairs (NaN for fewer than two distinct values).
-pub(super) fn correlation(pairs: &[(f64, f64)]) -> f64 {
+pub(crate) fn correlation(pairs: &[(f64, f64)]) -> f64 {
     let n = pairs.len() as f64;
     let (ma, mb) = pairs
         .iter()
@@ -13,7 +13,7 @@ pub(super) fn correlation(pairs: &[(f64, f64)]) -> f64 {
 }
 
 /// Slope of the least-squares line through `points` (NaN for fewer than two x values).
-pub(super) fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
+pub(crate) fn least_squares_slope(points: &[(f64, f64)]) -> f64 {
     let n = points.len() as f64;
     let (mx, my) = points
         .iter()

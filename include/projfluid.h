@@ -846,6 +846,91 @@ enum PfStatus pf_world_removed_count(const struct PfWorld *world, uint64_t *out)
 enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out);
 
 /**
+ * Adds a fluid material of rest density `rest_density` (kg/m³) and stores its id in `*out`:
+ * 1 for the first material added, then 2, 3, …; material 0 is the world's own fluid, of
+ * `PfParams.rest_density`. Fluid of the new material is made once
+ * `pf_world_set_fluid_material` chooses it. Every material shares the world's particle
+ * radius, so a particle of material i weighs rest_density_i / `PfParams.rest_density` times
+ * the world's particle mass, and its density reads about rest_density_i at rest
+ * (docs/method.md §14).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+ * rest density that is not finite or lies outside 0.1 to 10 times the world's rest
+ * density, the message giving the range in kg/m³; a world holding 256 materials already;
+ * a world on the GPU backend, which steps one material only). On any error no material is
+ * added and `*out` is untouched. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_add_material(struct PfWorld *world, double rest_density, uint16_t *out);
+
+/**
+ * Chooses `material` as the material of the fluid added from now on: by
+ * `pf_world_add_fluid_particles`, `pf_world_add_fluid_particles_with_velocities`,
+ * `pf_world_add_fluid_box`, and by the emitters added from now on (`pf_world_add_emitter_disc`,
+ * `pf_world_add_emitter_rect`; an emitter keeps the material chosen when it was added).
+ * Fluid already in the world keeps its material. A new world makes fluid of material 0.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material the
+ * world does not have, the message giving the valid range). On any error the choice is
+ * unchanged. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`.
+ */
+enum PfStatus pf_world_set_fluid_material(struct PfWorld *world, uint16_t material);
+
+/**
+ * Stores in `*out` the material the fluid added next is made of: 0, the world's own fluid,
+ * until `pf_world_set_fluid_material` chooses another.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_fluid_material(const struct PfWorld *world, uint16_t *out);
+
+/**
+ * Stores in `*out` the number of materials, the world's own fluid included: 1 in a new
+ * world, and the valid material ids are 0 to `*out` − 1.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_material_count(const struct PfWorld *world, size_t *out);
+
+/**
+ * Stores in `*out` the rest density (kg/m³) of `material`: `PfParams.rest_density` for
+ * material 0, and for the others the value `pf_world_add_material` was given.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+ * material the world does not have, the message giving the valid range); `*out` is then
+ * untouched.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_get_material_rest_density(const struct PfWorld *world,
+                                                 uint16_t material,
+                                                 double *out);
+
+/**
+ * Copies every fluid particle's material id into `out`, in ascending id order, the order
+ * of every other per-particle read (`pf_world_get_positions`, `pf_world_get_densities`,
+ * `pf_world_get_ids`, …). `capacity` is the length of `out` in ids; fluid count are needed
+ * and written. `*needed` (when `needed` is not NULL) receives that number on success and
+ * on `PF_ERROR_BUFFER_TOO_SMALL`, in which case `out` is untouched. `out` may be NULL only
+ * with capacity 0, to query the size. The world is not changed.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or point to `capacity` writable `uint16_t`s; `needed` must be NULL or writable.
+ */
+enum PfStatus pf_world_get_materials(const struct PfWorld *world,
+                                     uint16_t *out,
+                                     size_t capacity,
+                                     size_t *needed);
+
+/**
  * Takes one time step of `dt` seconds (0 < dt ≤ 1), or of the CFL-limited size when
  * `dt` ≤ 0 (the usual choice). The CFL rule sets the size of the next CFL step either way.
  *

@@ -2,10 +2,10 @@
 //!
 //! The C API test drives seeded random sequences of `pf_` calls — valid and invalid
 //! arguments (NULL, NaN, ±∞, negative, huge counts, short output buffers), steps, advances,
-//! reads, emitters, sinks and removals — against a small world, through the crate's
-//! `extern "C"` functions, and checks after every call: no panic (`PF_ERROR_PANIC`), a failed
-//! call changes nothing (counts, time, steps, positions, velocities, densities and ids bit for
-//! bit) and explains itself, a successful one clears the message, the counts add up (added +
+//! reads, emitters, sinks, removals and materials — against a small world, through the
+//! crate's `extern "C"` functions, and checks after every call: no panic (`PF_ERROR_PANIC`), a
+//! failed call changes nothing (counts, time, steps, positions, velocities, densities, ids and
+//! materials bit for bit) and explains itself, a successful one clears the message, the counts add up (added +
 //! emitted − removed = fluid), time moves as the call says, and nothing is NaN.
 //!
 //! The scene test feeds `Scene::from_json` mutated built-in scene files and random bytes and
@@ -124,6 +124,10 @@ struct Snapshot {
     ids: Vec<u64>,
     removed: u64,
     emitted: u64,
+    /// Every particle's material, the number of materials and the one fluid is added of.
+    materials: Vec<u16>,
+    material_count: usize,
+    fluid_material: u16,
 }
 
 fn ok(status: PfStatus, what: &str) {
@@ -187,6 +191,23 @@ fn snapshot(world: *mut PfWorld) -> Snapshot {
         unsafe { pf_world_get_ids(world, ids.as_mut_ptr(), ids.len(), &mut needed) },
         "ids",
     );
+    let mut materials = vec![u16::MAX; fluid];
+    let (mut material_count, mut fluid_material) = (0usize, u16::MAX);
+    // SAFETY: `materials` holds `fluid` ids; valid outputs.
+    unsafe {
+        ok(
+            pf_world_get_materials(world, materials.as_mut_ptr(), fluid, &mut needed),
+            "materials",
+        );
+        ok(
+            pf_world_material_count(world, &mut material_count),
+            "material_count",
+        );
+        ok(
+            pf_world_fluid_material(world, &mut fluid_material),
+            "fluid_material",
+        );
+    }
     // SAFETY: NUL-terminated by the library.
     let hash = unsafe { CStr::from_ptr(hash.as_ptr()) }
         .to_string_lossy()
@@ -203,6 +224,9 @@ fn snapshot(world: *mut PfWorld) -> Snapshot {
         ids,
         removed,
         emitted,
+        materials,
+        material_count,
+        fluid_material,
     }
 }
 
@@ -259,7 +283,7 @@ impl Fuzzer {
         // SAFETY (every call below): `w` is NULL or the live world; every pointer is NULL or
         // points to at least as many elements as the count passed with it.
         unsafe {
-            match self.rng.below(22) {
+            match self.rng.below(23) {
                 0 | 1 if !crowded => {
                     let (xyz, n, is_null) = self.input();
                     let status = pf_world_add_fluid_particles(w, Self::ptr(&xyz, is_null), n);
@@ -538,6 +562,83 @@ impl Fuzzer {
                     }
                     ("world_create", status, Moves::Nothing, 0)
                 }
+                22 => {
+                    // Materials: add one (ordinary and bad densities), choose one (known or
+                    // not), or read them back, per material and per particle (short buffers).
+                    let range = self.rng.pick(&[1usize, 2, 3, 8, 300]);
+                    let material = self.rng.below(range) as u16;
+                    match self.rng.below(4) {
+                        0 => {
+                            let rho = double(&mut self.rng, &[800.0, 1000.0, 1500.0, 3000.0]);
+                            let mut id = u16::MAX;
+                            let out = if self.rng.chance(5) {
+                                null_mut()
+                            } else {
+                                &mut id
+                            };
+                            let status = pf_world_add_material(w, rho, out);
+                            if status == PfStatus::PF_OK {
+                                assert!((1..u16::MAX).contains(&id), "add_material: id {id}");
+                            } else {
+                                assert_eq!(id, u16::MAX, "add_material wrote on failure");
+                            }
+                            ("add_material", status, Moves::Nothing, 0)
+                        }
+                        1 => {
+                            let status = pf_world_set_fluid_material(w, material);
+                            ("set_fluid_material", status, Moves::Nothing, 0)
+                        }
+                        2 => {
+                            let mut rho = -7.0;
+                            let out = if self.rng.chance(10) {
+                                null_mut()
+                            } else {
+                                &mut rho
+                            };
+                            let status = pf_world_get_material_rest_density(w, material, out);
+                            match status {
+                                PfStatus::PF_OK => assert!(rho.is_finite() && rho > 0.0),
+                                _ => assert_eq!(rho, -7.0, "get_material_rest_density wrote"),
+                            }
+                            ("get_material_rest_density", status, Moves::Nothing, 0)
+                        }
+                        _ => {
+                            let capacity = self.rng.below(fluid + 4);
+                            let mut buf = vec![0xabcd_u16; capacity];
+                            let mut needed = usize::MAX;
+                            let out = if capacity == 0 && self.rng.chance(50) {
+                                null_mut()
+                            } else {
+                                buf.as_mut_ptr()
+                            };
+                            let n = if self.rng.chance(20) {
+                                null_mut()
+                            } else {
+                                &mut needed
+                            };
+                            let status = pf_world_get_materials(w, out, capacity, n);
+                            match status {
+                                PfStatus::PF_OK => {
+                                    assert!(capacity >= fluid, "get_materials");
+                                    assert!(buf[fluid..].iter().all(|&m| m == 0xabcd));
+                                    assert!(buf[..fluid].iter().all(|&m| m < 0xabcd));
+                                }
+                                PfStatus::PF_ERROR_BUFFER_TOO_SMALL => {
+                                    assert!(capacity < fluid, "get_materials");
+                                    assert!(
+                                        buf.iter().all(|&m| m == 0xabcd),
+                                        "get_materials wrote"
+                                    );
+                                    if !n.is_null() {
+                                        assert_eq!(needed, fluid, "get_materials");
+                                    }
+                                }
+                                _ => {}
+                            }
+                            ("get_materials", status, Moves::Nothing, 0)
+                        }
+                    }
+                }
                 _ => ("skipped", PfStatus::PF_OK, Moves::Nothing, 0),
             }
         }
@@ -650,6 +751,18 @@ fn fuzz_world(seed: u64, calls: usize) {
         );
         assert!(after.removed >= before.removed && after.emitted >= before.emitted);
         assert_eq!(after.ids.len(), after.fluid, "{context}");
+        assert!(
+            after
+                .materials
+                .iter()
+                .all(|&m| (m as usize) < after.material_count)
+                && (after.fluid_material as usize) < after.material_count,
+            "{context}: materials"
+        );
+        assert!(
+            after.material_count >= before.material_count,
+            "{context}: a material was lost"
+        );
         assert!(after.ids.windows(2).all(|p| p[0] < p[1]), "{context}: ids");
         for (what, values) in [
             ("velocities", &after.velocities),

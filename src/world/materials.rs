@@ -49,4 +49,13 @@ impl World {
         self.gather_by_id(&self.fluid.materials, &mut out);
         out
     }
+
+    /// Writes every fluid particle's material into `out[..n]` in ascending id order,
+    /// n = [`World::fluid_count`], without allocating; `Err(n)` when `out` is shorter.
+    pub fn write_materials(&self, out: &mut [MaterialId]) -> Result<(), usize> {
+        let n = self.fluid_count();
+        let out = out.get_mut(..n).ok_or(n)?;
+        self.gather_by_id(&self.fluid.materials, out);
+        Ok(())
+    }
 }

@@ -39,6 +39,121 @@ static void field_walls(const PfParams *params, int steps) {
     pf_world_destroy(world);
 }
 
+/* Two liquids: water and a heavier material (1500 kg/m^3). Fluid added after choosing a
+ * material is made of it, the materials read back in the order of every per-particle read
+ * (the ids), and each particle's density reads in its own material's terms: a heavy layer
+ * at rest under water reads about 1500 kg/m^3, the water over it about 1000. */
+static void two_liquids(const PfParams *params, int steps) {
+    PfWorld *world = NULL;
+    OK(pf_world_create(params, &world));
+    size_t materials = 0;
+    uint16_t current = 7;
+    OK(pf_world_material_count(world, &materials));
+    OK(pf_world_fluid_material(world, &current));
+    CHECK(materials == 1 && current == 0);
+    double rho0 = 0.0;
+    OK(pf_world_get_material_rest_density(world, 0, &rho0));
+    CHECK(rho0 == params->rest_density);
+
+    /* A second material of water's own density, and the heavy one. */
+    uint16_t water = 0, heavy = 0;
+    OK(pf_world_add_material(world, params->rest_density, &water));
+    OK(pf_world_add_material(world, 1500.0, &heavy));
+    CHECK(water == 1 && heavy == 2);
+    OK(pf_world_material_count(world, &materials));
+    CHECK(materials == 3);
+    OK(pf_world_get_material_rest_density(world, heavy, &rho0));
+    CHECK(rho0 == 1500.0);
+    OK(pf_world_get_material_rest_density(world, water, &rho0));
+    CHECK(rho0 == params->rest_density);
+    OK(pf_world_fluid_material(world, &current));
+    CHECK(current == 0); /* adding a material does not choose it */
+
+    /* A 6 x 5 x 6 lattice one spacing and r/4 from the walls: its two bottom layers heavy,
+     * the three above them water (material 0), added as particles (not settled, so the
+     * layers start on the lattice). */
+    const float d = 0.05f, gap = 0.05625f, side = 5 * d + 2 * gap;
+    const float lo[3] = {0.0f, 0.0f, 0.0f}, hi[3] = {side, 0.5f, side};
+    OK(pf_world_add_container_box(world, lo, hi, 1));
+    float layer_heavy[3 * 72], layer_water[3 * 108];
+    size_t nh = 0, nw = 0;
+    for (int k = 0; k < 6; k++)
+        for (int j = 0; j < 5; j++)
+            for (int i = 0; i < 6; i++) {
+                float *p = j < 2 ? &layer_heavy[3 * nh++] : &layer_water[3 * nw++];
+                p[0] = gap + (float)i * d;
+                p[1] = gap + (float)j * d;
+                p[2] = gap + (float)k * d;
+            }
+    CHECK(nh == 72 && nw == 108);
+    OK(pf_world_set_fluid_material(world, heavy));
+    OK(pf_world_fluid_material(world, &current));
+    CHECK(current == heavy);
+    OK(pf_world_add_fluid_particles(world, layer_heavy, nh));
+    OK(pf_world_set_fluid_material(world, 0));
+    OK(pf_world_add_fluid_particles(world, layer_water, nw));
+    /* A small box of the second water material in the air, far above the water. */
+    OK(pf_world_set_fluid_material(world, water));
+    const float box_start[3] = {0.15f, 0.4f, 0.15f};
+    const size_t box_count[3] = {2, 2, 2};
+    OK(pf_world_add_fluid_box(world, box_start, box_count, NULL));
+    OK(pf_world_fluid_material(world, &current));
+    CHECK(current == water);
+
+    size_t n = 0, needed = 0;
+    OK(pf_world_fluid_count(world, &n));
+    CHECK(n == 72 + 108 + 8);
+    uint16_t *mat = malloc(n * sizeof *mat);
+    float *rho = malloc(n * sizeof *rho);
+    float *pos = malloc(3 * n * sizeof *pos);
+    CHECK(mat && rho && pos);
+    EXPECT(PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_materials(world, NULL, 0, &needed));
+    CHECK(needed == n);
+    OK(pf_world_get_materials(world, mat, n, &needed));
+    CHECK(needed == n);
+    size_t per_material[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++) {
+        CHECK(mat[i] < 3);
+        per_material[mat[i]]++;
+        /* In the order the particles were added. */
+        CHECK(mat[i] == (i < 72 ? heavy : i < 180 ? 0 : water));
+    }
+    CHECK(per_material[0] == 108 && per_material[water] == 8 && per_material[heavy] == 72);
+
+    /* A few steps (which reorder the particles' storage): the materials stay with their
+     * particles and read in the same order. */
+    for (int i = 0; i < (steps > 1 ? steps : 1); i++) OK(pf_world_step(world, 0.0));
+    memset(mat, 0xff, n * sizeof *mat);
+    OK(pf_world_get_materials(world, mat, n, NULL));
+    for (size_t i = 0; i < n; i++) CHECK(mat[i] == (i < 72 ? heavy : i < 180 ? 0 : water));
+    OK(pf_world_get_densities(world, rho, n, NULL));
+    OK(pf_world_get_positions(world, pos, 3 * n, NULL));
+    /* The heavy layer at rest: its densest particle near 1500 kg/m^3, its mean about 1.5
+     * times the water's; the water's densest particle near 1000. Nothing moved far. */
+    double heavy_mean = 0.0, water_mean = 0.0;
+    float heavy_max = 0.0f, water_max = 0.0f;
+    for (size_t i = 0; i < n; i++) {
+        for (int a = 0; a < 3; a++) CHECK(isfinite(pos[3 * i + a]));
+        CHECK(isfinite(rho[i]) && rho[i] > 0.0f);
+        if (mat[i] == heavy) {
+            CHECK(pos[3 * i + 1] < 0.11f); /* still in the bottom two layers */
+            heavy_mean += rho[i] / 72.0;
+            heavy_max = rho[i] > heavy_max ? rho[i] : heavy_max;
+        } else if (mat[i] == 0) {
+            water_mean += rho[i] / 108.0;
+            water_max = rho[i] > water_max ? rho[i] : water_max;
+        }
+    }
+    if (!(heavy_max > 1450.0f && heavy_max < 1560.0f && water_max > 950.0f &&
+          water_max < 1040.0f && heavy_mean > 1.4 * water_mean && heavy_mean < 1.7 * water_mean))
+        FAIL("heavy: densest %.1f, mean %.1f kg/m^3; water: densest %.1f, mean %.1f kg/m^3",
+             heavy_max, heavy_mean, water_max, water_mean);
+    free(mat);
+    free(rho);
+    free(pos);
+    pf_world_destroy(world);
+}
+
 int main(int argc, char **argv) {
     int steps = argc > 1 ? atoi(argv[1]) : 5;
 
@@ -219,5 +334,6 @@ int main(int argc, char **argv) {
     pf_world_destroy(world);
     pf_world_destroy(NULL);
     field_walls(&params, steps);
+    two_liquids(&params, steps);
     return 0;
 }

@@ -361,6 +361,92 @@ int main(void) {
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_advance(w, 1e-300));
     REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_relax(w, 5e-5, 1.0));
 
+    /* --- Materials. --- */
+    {
+        uint16_t id = 77, material = 77;
+        size_t count = 0;
+        double rho0 = -1.0;
+        uint16_t mats[27 + 4];
+        OK(pf_world_add_material(w, 1500.0, &id));
+        CHECK(id == 1);
+        OK(pf_world_material_count(w, &count));
+        CHECK(count == 2);
+        id = 77;
+        /* NULL world, for every material function. */
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_material(NULL, 1200.0, &id));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_set_fluid_material(NULL, 1));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_material(NULL, &material));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_material_count(NULL, &count));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_rest_density(NULL, 0, &rho0));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(NULL, mats, 27, &needed));
+        CHECK(strstr(last_msg, "world must not be NULL") != NULL);
+        /* NULL outputs: a material is not added for want of a place to put its id. */
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_add_material(w, 1200.0, NULL));
+        CHECK(strcmp(last_msg, "pf_world_add_material: out must not be NULL") == 0);
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_material(w, NULL));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_material_count(w, NULL));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_rest_density(w, 0, NULL));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(w, NULL, 27, NULL));
+        CHECK(strstr(last_msg, "out must not be NULL") != NULL);
+        /* Rest densities that are not finite or lie outside 0.1 to 10 times the world's
+           (100 to 10000 kg/m^3 here), the argument and the range named. */
+        const double bad_densities[] = {NAN, INFINITY, -INFINITY, 0.0, -1000.0, 99.9, 10000.5,
+                                        1e300};
+        for (size_t i = 0; i < sizeof bad_densities / sizeof *bad_densities; i++) {
+            REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_add_material(w, bad_densities[i], &id));
+            CHECK(strstr(last_msg, "pf_world_add_material: rest_density must be between 100 and "
+                                   "10000 kg/m³") != NULL);
+        }
+        /* Unknown material ids, the range named. */
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_set_fluid_material(w, 2));
+        CHECK(strstr(last_msg, "material must name one of the world's 2 materials (0 to 1), "
+                               "got 2") != NULL);
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_set_fluid_material(w, UINT16_MAX));
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_get_material_rest_density(w, 2, &rho0));
+        CHECK(strstr(last_msg, "material must name one of the world's 2 materials (0 to 1), "
+                               "got 2") != NULL);
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+               pf_world_get_material_rest_density(w, UINT16_MAX, &rho0));
+        /* A short buffer: the size needed is reported and the buffer is left untouched. */
+        for (size_t i = 0; i < sizeof mats / sizeof *mats; i++) mats[i] = 0xabcd;
+        needed = 0;
+        REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_materials(w, mats, 26, &needed));
+        CHECK(needed == 27);
+        REJECT(w, PF_ERROR_BUFFER_TOO_SMALL, pf_world_get_materials(w, mats, 0, NULL));
+        for (size_t i = 0; i < sizeof mats / sizeof *mats; i++) CHECK(mats[i] == 0xabcd);
+        /* None of that changed the materials, the choice, or the outputs. */
+        CHECK(id == 77 && material == 77 && rho0 == -1.0);
+        OK(pf_world_material_count(w, &count));
+        CHECK(count == 2);
+        OK(pf_world_fluid_material(w, &material));
+        CHECK(material == 0);
+        OK(pf_world_get_material_rest_density(w, 1, &rho0));
+        CHECK(rho0 == 1500.0);
+        /* A larger buffer than needed is fine; the tail stays untouched. */
+        OK(pf_world_get_materials(w, mats, sizeof mats / sizeof *mats, &needed));
+        CHECK(needed == 27 && mats[0] == 0 && mats[26] == 0 && mats[27] == 0xabcd);
+
+        /* A world holds at most 256 materials; the one too many adds nothing. */
+        PfWorld *full = NULL;
+        OK(pf_world_create(&params, &full));
+        for (int i = 1; i < 256; i++) {
+            OK(pf_world_add_material(full, 100.0 + i, &id));
+            CHECK(id == i);
+        }
+        REJECT(full, PF_ERROR_INVALID_ARGUMENT, pf_world_add_material(full, 1000.0, &id));
+        CHECK(strstr(last_msg, "at most 256 materials") != NULL);
+        CHECK(id == 255);
+        OK(pf_world_material_count(full, &count));
+        CHECK(count == 256);
+        OK(pf_world_set_fluid_material(full, 255));
+        OK(pf_world_get_material_rest_density(full, 255, &rho0));
+        CHECK(rho0 == 355.0);
+        REJECT(full, PF_ERROR_INVALID_ARGUMENT, pf_world_set_fluid_material(full, 256));
+        OK(pf_world_fluid_material(full, &material));
+        CHECK(material == 255);
+        pf_world_destroy(full);
+    }
+
     /* Functions returning nothing leave the last message alone, even given NULL. */
     EXPECT(PF_ERROR_NULL_POINTER, pf_world_time(w, NULL));
     char kept[512];

@@ -20,6 +20,7 @@ from ctypes import (
     c_int,
     c_size_t,
     c_uint,
+    c_uint16,
     c_uint32,
     c_uint64,
     c_void_p,
@@ -121,6 +122,7 @@ _world = c_void_p
 _floats = POINTER(c_float)
 _doubles = POINTER(c_double)
 _sizes = POINTER(c_size_t)
+_u16s = POINTER(c_uint16)
 _u32s = POINTER(c_uint32)
 _u64s = POINTER(c_uint64)
 _params = POINTER(PfParams)
@@ -175,6 +177,13 @@ SIGNATURES: dict[str, tuple[list[Any], Any]] = {
     "pf_world_remove_particles": ([_world, _u64s, c_size_t, _sizes], _status),
     "pf_world_removed_count": ([_world, _u64s], _status),
     "pf_world_emitted_count": ([_world, _u64s], _status),
+    # materials
+    "pf_world_add_material": ([_world, c_double, _u16s], _status),
+    "pf_world_set_fluid_material": ([_world, c_uint16], _status),
+    "pf_world_fluid_material": ([_world, _u16s], _status),
+    "pf_world_material_count": ([_world, _sizes], _status),
+    "pf_world_get_material_rest_density": ([_world, c_uint16, _doubles], _status),
+    "pf_world_get_materials": ([_world, _u16s, c_size_t, _sizes], _status),
     # stepping
     "pf_world_step": ([_world, c_double], _status),
     "pf_world_advance": ([_world, c_double], _status),

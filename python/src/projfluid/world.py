@@ -5,9 +5,20 @@ reads; rigid bodies are in :mod:`projfluid.bodies`, emitters and sinks in
 from __future__ import annotations
 
 import contextlib
+import operator
 import os
 from collections.abc import Callable
-from ctypes import byref, c_char, c_double, c_float, c_size_t, c_uint32, c_uint64, c_void_p
+from ctypes import (
+    byref,
+    c_char,
+    c_double,
+    c_float,
+    c_size_t,
+    c_uint16,
+    c_uint32,
+    c_uint64,
+    c_void_p,
+)
 from types import TracebackType
 from typing import Any
 
@@ -207,6 +218,53 @@ class World(BodiesMixin, FlowMixin):
         c_transform = None if transform is None else byref(transform.to_c())
         self._call(lib.pf_world_add_obj, os.fsencode(path), c_transform)
 
+    # --- materials --------------------------------------------------------------------
+
+    def add_material(self, rest_density: float) -> int:
+        """Adds a fluid material, a liquid of ``rest_density`` (kg/m³, 0.1 to 10 times the
+        world's ``rest_density``), and returns its id: 1 for the first one added, then 2,
+        3, …; material 0 is the world's own fluid. Fluid of it is made after
+        :meth:`set_fluid_material` chooses it. A rest density that is not finite or out of
+        range, a 257th material, or a world on the GPU backend (which steps one material)
+        raises :class:`~projfluid.errors.InvalidArgumentError` and adds nothing."""
+        out = c_uint16()
+        self._call(lib.pf_world_add_material, float(rest_density), byref(out))
+        return out.value
+
+    def set_fluid_material(self, material: int) -> None:
+        """Chooses ``material`` (an id from :meth:`add_material`, or 0) as the material of
+        the fluid added from now on: by :meth:`add_fluid_box`, :meth:`add_fluid_particles`
+        and the emitters added from now on. Fluid already in the world keeps its material.
+        An id the world does not have raises :class:`~projfluid.errors.InvalidArgumentError`
+        and changes nothing."""
+        self._call(lib.pf_world_set_fluid_material, _material_id(material))
+
+    @property
+    def fluid_material(self) -> int:
+        """The material the fluid added next is made of (0, the world's own fluid, until
+        :meth:`set_fluid_material` chooses another)."""
+        out = c_uint16()
+        self._call(lib.pf_world_fluid_material, byref(out))
+        return out.value
+
+    @property
+    def material_count(self) -> int:
+        """Number of materials, the world's own fluid included (ids 0 to count − 1)."""
+        return self._size(lib.pf_world_material_count)
+
+    def material_rest_density(self, material: int) -> float:
+        """The rest density (kg/m³) of ``material``: the world's ``rest_density`` for 0.
+        An id the world does not have raises
+        :class:`~projfluid.errors.InvalidArgumentError`."""
+        out = c_double()
+        self._call(lib.pf_world_get_material_rest_density, _material_id(material), byref(out))
+        return out.value
+
+    def materials(self, out: np.ndarray | None = None) -> np.ndarray:
+        """Every fluid particle's material id as an (n,) uint16 array, in ascending id
+        order like :meth:`positions`; ``out`` as in :meth:`positions`."""
+        return self._read(lib.pf_world_get_materials, out, 1, np.uint16, c_uint16, "out")
+
     # --- stepping ---------------------------------------------------------------------
 
     def step(self, dt: float = 0.0) -> StepStats:
@@ -318,3 +376,12 @@ class World(BodiesMixin, FlowMixin):
         out = (c_char * 65)()
         self._call(lib.pf_world_positions_hash, out, len(out), None)
         return out.value.decode()
+
+
+def _material_id(material: int) -> int:
+    """``material`` as a C ``uint16_t`` material id: an integer (else :class:`TypeError`) in
+    0..65535 (else :class:`ValueError`; C would see it wrapped)."""
+    value = operator.index(material)
+    if not 0 <= value <= 0xFFFF:
+        raise ValueError(f"material must be a material id in 0..65535, got {value}")
+    return value

@@ -1,6 +1,6 @@
 //! `PfWorld`, the opaque handle over a [`World`], with the functions that create and destroy
-//! it; the functions that fill it, let fluid in and out, step it and read it are in
-//! [`fill`], [`flow`], [`step`] and [`read`].
+//! it; the functions that fill it, let fluid in and out, choose its liquids, step it and read
+//! it are in [`fill`], [`flow`], [`materials`], [`step`] and [`read`].
 
 use super::checked::Args;
 use super::params::PfParams;
@@ -9,16 +9,18 @@ use crate::{Params, World};
 use std::sync::{Arc, Mutex, MutexGuard, PoisonError, TryLockError};
 use std::thread::JoinHandle;
 
-// cbindgen lists functions in the order their modules are declared: fill, flow, step, read
-// (the blank line keeps rustfmt from sorting them).
+// cbindgen lists functions in the order their modules are declared: fill, flow, materials,
+// step, read (the blank line keeps rustfmt from sorting them).
 mod fill;
 mod flow;
+mod materials;
 mod step;
 
 mod read;
 
 pub use fill::*;
 pub use flow::*;
+pub use materials::*;
 pub use read::*;
 pub use step::*;
 

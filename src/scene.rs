@@ -23,13 +23,13 @@ pub use crate::boundary::ContainerWalls;
 pub use bodies::{BodyShape, MotionSpec, SceneBody};
 pub use spec::{
     BoxSpec, ContainerSpec, DEFAULT_OUTPUT_EVERY, FluidBlock, MeshSource, ObstacleSpec, OutputSpec,
-    SceneMaterial,
+    SceneEmitter, SceneMaterial,
 };
 
 use crate::boundary::Aabb;
 use crate::params::Params;
 use crate::probe::ProbeSet;
-use crate::{EmitterSpec, Error, Vec3, World};
+use crate::{Error, Vec3, World};
 use std::path::Path;
 
 /// A complete simulation setup.
@@ -54,7 +54,7 @@ pub struct Scene {
     pub fluid_blocks: Vec<FluidBlock>,
     /// Emitters inserting fluid from the start of the first step (may be empty). Emitter `i`
     /// gets index `i`.
-    pub emitters: Vec<EmitterSpec>,
+    pub emitters: Vec<SceneEmitter>,
     /// Sinks: boxes removing the fluid in them at the end of every step (may be empty).
     pub sinks: Vec<BoxSpec>,
     /// The domain: fluid outside it at the end of a step is removed (`None`: kept).
@@ -214,10 +214,13 @@ impl Scene {
     /// The world's material id of `block`'s material: 0 for the world's own fluid (or a name
     /// the scene lacks, which validation refuses), else one past its index in `materials`.
     pub fn material_id(&self, block: &FluidBlock) -> crate::MaterialId {
-        block
-            .material
-            .as_ref()
-            .and_then(|name| self.materials.iter().position(|m| &m.name == name))
+        self.material_named(block.material.as_deref())
+    }
+
+    /// The id in the built world of the material named `name` (0, the world's own fluid, for
+    /// `None` or a name the scene does not define).
+    pub fn material_named(&self, name: Option<&str>) -> crate::MaterialId {
+        name.and_then(|name| self.materials.iter().position(|m| m.name == name))
             .map_or(0, |i| (i + 1) as crate::MaterialId)
     }
 

@@ -256,16 +256,19 @@ fn the_backend_travels_with_the_checkpoint() {
 /// the removed count, the emitter's progress and the boxes are in the checkpoint.
 #[test]
 fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
-    use crate::scene::BoxSpec;
+    use crate::scene::{BoxSpec, SceneEmitter};
     use crate::{EmitterShape, EmitterSpec};
     // The emitter, sink and domain come from the scene, the removal by id from the caller.
     let mut scene = small_scene();
-    scene.emitters.push(EmitterSpec {
-        shape: EmitterShape::Disc { radius: 0.08 },
-        position: Vec3::new(0.15, 0.7, 0.3),
-        direction: Vec3::new(0.3, -1.0, 0.0),
-        speed: 1.2,
-        end_time: Some(0.5),
+    scene.emitters.push(SceneEmitter {
+        spec: EmitterSpec {
+            shape: EmitterShape::Disc { radius: 0.08 },
+            position: Vec3::new(0.15, 0.7, 0.3),
+            direction: Vec3::new(0.3, -1.0, 0.0),
+            speed: 1.2,
+            end_time: Some(0.5),
+        },
+        material: None,
     });
     scene.sinks.push(BoxSpec {
         min: [0.0; 3],

@@ -2,7 +2,7 @@
 
 use super::{
     BodyShape, BoxSpec, ContainerSpec, ContainerWalls, FluidBlock, MeshSource, MotionSpec,
-    ObstacleSpec, OutputSpec, Scene, SceneBody, SceneMaterial,
+    ObstacleSpec, OutputSpec, Scene, SceneBody, SceneEmitter, SceneMaterial,
 };
 use crate::body::BodyKind;
 use crate::boundary::Transform;
@@ -187,7 +187,10 @@ fn fountain() -> Scene {
     let mut scene = Scene {
         materials: Vec::new(),
         fluid_blocks: vec![block([0.05; 3], [19, 4, 19])],
-        emitters: vec![emitter],
+        emitters: vec![SceneEmitter {
+            spec: emitter,
+            material: None,
+        }],
         sinks: vec![drain],
         ..dam_break(
             "fountain",

@@ -265,7 +265,7 @@ impl SceneFile {
             .unwrap_or_default()
             .into_iter()
             .enumerate()
-            .map(|(i, e)| e.into_spec(i))
+            .map(|(i, e)| e.into_emitter(i))
             .collect::<Result<_, _>>()?;
         let o = self.output.unwrap_or_default();
         Ok(Scene {
@@ -315,8 +315,14 @@ impl SceneFile {
                 .filter(|b: &Vec<BodyFile>| !b.is_empty()),
             materials: Some(scene.materials.clone()).filter(|m| !m.is_empty()),
             fluid_blocks: scene.fluid_blocks.clone(),
-            emitters: Some(scene.emitters.iter().map(EmitterFile::from_spec).collect())
-                .filter(|e: &Vec<EmitterFile>| !e.is_empty()),
+            emitters: Some(
+                scene
+                    .emitters
+                    .iter()
+                    .map(EmitterFile::from_emitter)
+                    .collect(),
+            )
+            .filter(|e: &Vec<EmitterFile>| !e.is_empty()),
             sinks: Some(scene.sinks.clone()).filter(|s| !s.is_empty()),
             domain: scene.domain,
             solver: Some(SolverFile {

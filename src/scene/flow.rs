@@ -63,7 +63,16 @@ fn check_box(key: &str, b: &BoxSpec) -> Result<(), Error> {
 /// Checks the scene's emitters (on the fluid lattice of spacing 2r), sinks and domain.
 pub(super) fn check_flow(scene: &Scene) -> Result<(), Error> {
     let spacing = 2.0 * scene.params.particle_radius;
-    for (i, spec) in scene.emitters.iter().enumerate() {
+    for (i, emitter) in scene.emitters.iter().enumerate() {
+        let spec = &emitter.spec;
+        let named = emitter.material.as_deref();
+        if let Some(name) = named.filter(|_| scene.material_named(named) == 0) {
+            return Err(Error::invalid(
+                format!("emitters[{i}].material"),
+                format!("{name:?}"),
+                "must name one of the scene's materials",
+            ));
+        }
         let state = EmitterState {
             spec: *spec,
             travelled: spacing,
@@ -86,11 +95,14 @@ impl Scene {
     /// sinks and domain to `world`. Errors start with `emitters[i]: `, `sinks[i]: ` or
     /// `domain: `. [`Scene::build_world`] calls it.
     pub fn add_flow(&self, world: &mut World) -> Result<(), Error> {
-        for (i, spec) in self.emitters.iter().enumerate() {
+        for (i, emitter) in self.emitters.iter().enumerate() {
+            let prefix = format!("emitters[{i}]: ");
             world
-                .add_emitter(*spec)
-                .map_err(|e| super::prefixed(e, &format!("emitters[{i}]: ")))?;
+                .set_fluid_material(self.material_named(emitter.material.as_deref()))
+                .and_then(|()| world.add_emitter(emitter.spec))
+                .map_err(|e| super::prefixed(e, &prefix))?;
         }
+        world.set_fluid_material(0)?;
         for (i, s) in self.sinks.iter().enumerate() {
             world
                 .add_sink(s.aabb())
@@ -129,10 +141,13 @@ mod tests {
     fn emitters_sinks_and_domain_are_read_built_and_written_back() {
         let scene = Scene::from_json(&with(FLOW)).unwrap();
         assert_eq!(scene.emitters.len(), 2);
-        assert_eq!(scene.emitters[0].shape, EmitterShape::Disc { radius: 0.2 });
-        assert_eq!(scene.emitters[0].end_time, Some(0.3));
-        assert_eq!(scene.emitters[1].end_time, None);
-        assert_eq!(scene.emitters[1].direction, Vec3::new(1.0, 0.0, 0.0));
+        assert_eq!(
+            scene.emitters[0].spec.shape,
+            EmitterShape::Disc { radius: 0.2 }
+        );
+        assert_eq!(scene.emitters[0].spec.end_time, Some(0.3));
+        assert_eq!(scene.emitters[1].spec.end_time, None);
+        assert_eq!(scene.emitters[1].spec.direction, Vec3::new(1.0, 0.0, 0.0));
         assert_eq!(scene.sinks[0].max, [0.2; 3]);
         assert_eq!(scene.domain.unwrap().max, [1.0, 3.0, 1.0]);
         assert_eq!(Scene::from_json(&scene.to_json()).unwrap(), scene);
@@ -145,6 +160,35 @@ mod tests {
         let plain = Scene::from_json(GOOD).unwrap().to_json();
         assert!(!plain.contains("emitters") && !plain.contains("sinks"));
         assert!(!plain.contains("domain"));
+    }
+
+    /// An emitter's `material` names one of the scene's materials: it emits that liquid,
+    /// fluid blocks keep theirs, and the key is written back.
+    #[test]
+    fn an_emitter_emits_the_material_it_names() {
+        let json = with(
+            r#""materials": [{"name": "oil", "rest_density": 800}],
+        "emitters": [{"disc": {"radius": 0.2}, "position": [0.5, 2.5, 0.5],
+                      "direction": [0, -1, 0], "speed": 1.5, "material": "oil"}]"#,
+        );
+        let scene = Scene::from_json(&json).unwrap();
+        assert_eq!(scene.emitters[0].material.as_deref(), Some("oil"));
+        assert_eq!(Scene::from_json(&scene.to_json()).unwrap(), scene);
+        let mut world = scene.build_world().unwrap();
+        let blocks = world.fluid_count();
+        assert_eq!(world.fluid_material(), 0);
+        world.step().unwrap();
+        let materials = world.particle_materials();
+        assert!(materials.len() > blocks);
+        assert!(materials[..blocks].iter().all(|&m| m == 0));
+        assert!(materials[blocks..].iter().all(|&m| m == 1));
+        let unknown = json.replace("\"material\": \"oil\"", "\"material\": \"tar\"");
+        let e = message(Scene::from_json(&unknown));
+        assert!(
+            e.contains("emitters[0].material")
+                && e.contains("must name one of the scene's materials"),
+            "{e}"
+        );
     }
 
     #[test]

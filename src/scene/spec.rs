@@ -48,11 +48,22 @@ pub struct FluidBlock {
     pub material: Option<String>,
 }
 
-/// A liquid besides the world's own fluid (docs/method.md §14), named for the fluid blocks.
+/// One emitter of a scene: its opening and inflow, and the liquid it emits.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneEmitter {
+    /// The opening, position, direction, speed and end time.
+    pub spec: crate::emitter::EmitterSpec,
+    /// The name of the scene's material the emitter emits (one of [`super::Scene`]'s
+    /// `materials`; `None`: the world's own fluid).
+    pub material: Option<String>,
+}
+
+/// A liquid besides the world's own fluid (docs/method.md §14), named for the fluid blocks
+/// and emitters.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneMaterial {
-    /// The name fluid blocks give in their `material` key (unique, not empty).
+    /// The name fluid blocks and emitters give in their `material` key (unique, not empty).
     pub name: String,
     /// Rest density ρ0 (kg/m³), between a tenth and ten times the scene's `rest_density`.
     pub rest_density: f64,

@@ -1,8 +1,10 @@
 //! One entry of a scene file's `emitters`: one opening (`disc` or `rect`), position,
-//! direction, speed and optional end time, converted to and from [`EmitterSpec`]. Sinks and
+//! direction, speed, optional end time and material, converted to and from a
+//! [`SceneEmitter`]. Sinks and
 //! the domain are plain [`BoxSpec`](crate::scene::BoxSpec)s.
 
 use crate::emitter::{EmitterShape, EmitterSpec};
+use crate::scene::SceneEmitter;
 use crate::{Error, Vec3};
 use serde::{Deserialize, Serialize};
 
@@ -33,11 +35,13 @@ pub(super) struct EmitterFile {
     speed: f64,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     end_time: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    material: Option<String>,
 }
 
 impl EmitterFile {
     /// Emitter `i`.
-    pub(super) fn into_spec(self, i: usize) -> Result<EmitterSpec, Error> {
+    pub(super) fn into_emitter(self, i: usize) -> Result<SceneEmitter, Error> {
         let shape = match (self.disc, self.rect) {
             (Some(d), None) => EmitterShape::Disc { radius: d.radius },
             (None, Some(r)) => EmitterShape::Rectangle {
@@ -54,17 +58,22 @@ impl EmitterFile {
                 });
             }
         };
-        Ok(EmitterSpec {
+        let spec = EmitterSpec {
             shape,
             position: Vec3::from(self.position),
             direction: Vec3::from(self.direction),
             speed: self.speed,
             end_time: self.end_time,
+        };
+        Ok(SceneEmitter {
+            spec,
+            material: self.material,
         })
     }
 
     /// Every key of the spec written out.
-    pub(super) fn from_spec(spec: &EmitterSpec) -> Self {
+    pub(super) fn from_emitter(emitter: &SceneEmitter) -> Self {
+        let spec = &emitter.spec;
         let (disc, rect) = match spec.shape {
             EmitterShape::Disc { radius } => (Some(DiscFile { radius }), None),
             EmitterShape::Rectangle { half_extents } => (None, Some(RectFile { half_extents })),
@@ -77,6 +86,7 @@ impl EmitterFile {
             direction: array(spec.direction),
             speed: spec.speed,
             end_time: spec.end_time,
+            material: emitter.material.clone(),
         }
     }
 }

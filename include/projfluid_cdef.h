@@ -22,7 +22,7 @@
  * Version of the binary interface these declarations describe; compare it with
  * pf_abi_version() at run time to detect a declarations/library mismatch.
  */
-enum { PF_ABI_VERSION = 5 };
+enum { PF_ABI_VERSION = 6 };
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -204,7 +204,8 @@ typedef struct PfTransform {
  * `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
  * validates it. The struct is plain data owned by the caller; the library copies it.
  * Fields added in later versions are appended at its end (`kinematic_viscosity` and
- * `no_slip` in ABI version 4, `backend` in 5), and each addition raises `PF_ABI_VERSION`.
+ * `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6), and each
+ * addition raises `PF_ABI_VERSION`.
  */
 typedef struct PfParams {
     /**
@@ -341,9 +342,15 @@ typedef struct PfParams {
      * no world, where it cannot be had; `pf_params_validate` checks only the value. A world
      * on the GPU refuses bodies, emitters, walls built as fields, further materials and
      * solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only
-     * with `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+     * with `kinematic_viscosity` and `vorticity_confinement` 0. Default `PF_BACKEND_CPU`.
      */
     uint32_t backend;
+    /**
+     * Vorticity confinement coefficient ε in [0, 10] (dimensionless; 0 = off): an
+     * acceleration ε·H·|ω|·(N × ω) that gives back rotation the solver and XSPH damp
+     * (docs/method.md §15); 0.1–1 is a useful range. Default 0.
+     */
+    double vorticity_confinement;
 } PfParams;
 
 /**

@@ -1,5 +1,5 @@
 //! Non-pressure forces: what acts on the fluid besides the density constraint (the physical
-//! viscosity and the XSPH filter). They change the velocities after a step's positions are
+//! viscosity, vorticity confinement and the XSPH filter). They change the velocities after a step's positions are
 //! final (docs/method.md §1.3).
 
 use crate::Vec3;
@@ -8,9 +8,11 @@ use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use crate::params::Params;
 use viscosity::Viscosity;
+use vorticity::VorticityConfinement;
 use xsph::Xsph;
 
 mod viscosity;
+mod vorticity;
 mod xsph;
 
 /// What a force reads besides the fluid: the constraint's constants, the step's
@@ -42,6 +44,10 @@ pub(crate) fn from_params(params: &Params) -> Vec<Box<dyn NonPressureForce>> {
     if params.kinematic_viscosity > 0.0 {
         let walls = params.no_slip;
         forces.push(Box::new(Viscosity::new(params.kinematic_viscosity, walls)));
+    }
+    if params.vorticity_confinement > 0.0 {
+        let epsilon = params.vorticity_confinement;
+        forces.push(Box::new(VorticityConfinement::new(epsilon)));
     }
     if params.viscosity > 0.0 {
         forces.push(Box::new(Xsph::new(params.viscosity)));

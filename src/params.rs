@@ -262,6 +262,9 @@ pub struct Params {
     /// 0, the default, leaves it out; water is 1e-6, olive oil about 1e-4, honey 1e-2 and
     /// more. Stable at every value and step size.
     pub kinematic_viscosity: f64,
+    /// Vorticity confinement coefficient ε (dimensionless, docs/method.md §15): 0, the
+    /// default, leaves it out; 0.1–1 gives back rotation that the iteration and XSPH damp.
+    pub vorticity_confinement: f64,
     /// Whether the walls, static obstacles and static bodies hold the fluid with no slip under
     /// the physical viscosity (true, the default) or let it slide (free slip). Moving bodies
     /// and walls built as fields let it slide either way.
@@ -274,6 +277,10 @@ pub struct Params {
     /// changes it.
     pub backend: Backend,
 }
+
+/// The largest vorticity confinement coefficient ε a world accepts (dimensionless): beyond it
+/// the confinement's acceleration outgrows the rotation it confines within a step.
+pub const MAX_VORTICITY_CONFINEMENT: f64 = 10.0;
 
 /// The longest time step (s) a world takes: the bound on `dt_min`, `dt_max` and
 /// `dt_initial` and on an explicit step's size, checked by one rule ([`check_step`]).
@@ -372,6 +379,7 @@ impl Params {
             dt_initial: 1e-3,
             viscosity: 0.01,
             kinematic_viscosity: 0.0,
+            vorticity_confinement: 0.0,
             no_slip: true,
             threads: 0,
             backend: Backend::Cpu,

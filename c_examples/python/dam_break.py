@@ -49,6 +49,7 @@ class PfParams(ctypes.Structure):
         ("kinematic_viscosity", c_double),
         ("no_slip", c_uint32),
         ("backend", c_uint32),
+        ("vorticity_confinement", c_double),
     ]
 
 

@@ -31,6 +31,8 @@ pub struct RunSummary {
     /// Walls, static obstacles and static bodies held the fluid with no slip under the
     /// physical viscosity (false: free slip; no effect while `kinematic_viscosity` is 0).
     pub no_slip: bool,
+    /// Vorticity confinement ε (dimensionless; 0 = off).
+    pub vorticity_confinement: f64,
     /// Worker threads.
     pub threads: usize,
     /// Fluid particles.
@@ -171,6 +173,7 @@ impl RunAccumulator {
             coarse_correction: p.coarse_correction,
             kinematic_viscosity: p.kinematic_viscosity,
             no_slip: p.no_slip,
+            vorticity_confinement: p.vorticity_confinement,
             threads: world.thread_count(),
             particles: world.fluid_count(),
             boundary_particles: world.boundary_count(),

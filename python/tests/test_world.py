@@ -179,6 +179,19 @@ def test_the_physical_viscosity_and_its_wall_condition_reach_the_world() -> None
         small_params(kinematic_viscosity="honey")
 
 
+def test_vorticity_confinement_reaches_the_world() -> None:
+    assert projfluid.Params().vorticity_confinement == 0.0
+    swirl = small_params(vorticity_confinement=0.3)
+    assert swirl.to_c().vorticity_confinement == 0.3
+    assert projfluid.Params.from_c(swirl.to_c()) == swirl
+    with projfluid.World(swirl) as world:
+        assert world.params.vorticity_confinement == 0.3
+    for bad in (-0.1, 11.0, math.nan):
+        with pytest.raises(projfluid.InvalidArgumentError) as caught:
+            small_params(vorticity_confinement=bad)
+        assert "params->vorticity_confinement must lie in [0, 10]" in caught.value.message
+
+
 def test_the_backend_is_a_choice_passed_to_the_c_library() -> None:
     defaults = projfluid.Params()
     assert defaults.backend == "cpu" and defaults.to_c().backend == 0

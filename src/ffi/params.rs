@@ -71,7 +71,8 @@ const _: () = assert!(size_of::<PfProjectionWeight>() == size_of::<c_int>());
 /// `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
 /// validates it. The struct is plain data owned by the caller; the library copies it.
 /// Fields added in later versions are appended at its end (`kinematic_viscosity` and
-/// `no_slip` in ABI version 4, `backend` in 5), and each addition raises `PF_ABI_VERSION`.
+/// `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6), and each
+/// addition raises `PF_ABI_VERSION`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PfParams {
@@ -156,8 +157,12 @@ pub struct PfParams {
     /// no world, where it cannot be had; `pf_params_validate` checks only the value. A world
     /// on the GPU refuses bodies, emitters, walls built as fields, further materials and
     /// solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only
-    /// with `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+    /// with `kinematic_viscosity` and `vorticity_confinement` 0. Default `PF_BACKEND_CPU`.
     pub backend: u32,
+    /// Vorticity confinement coefficient ε in [0, 10] (dimensionless; 0 = off): an
+    /// acceleration ε·H·|ω|·(N × ω) that gives back rotation the solver and XSPH damp
+    /// (docs/method.md §15); 0.1–1 is a useful range. Default 0.
+    pub vorticity_confinement: f64,
 }
 
 impl From<&Params> for PfParams {
@@ -208,6 +213,7 @@ impl From<&Params> for PfParams {
                 Backend::Cpu => PfBackend::PF_BACKEND_CPU as u32,
                 Backend::Gpu => PfBackend::PF_BACKEND_GPU as u32,
             },
+            vorticity_confinement: p.vorticity_confinement,
         }
     }
 }
@@ -310,6 +316,7 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         dt_initial: field!(dt_initial),
         viscosity: field!(viscosity),
         kinematic_viscosity: field!(kinematic_viscosity),
+        vorticity_confinement: field!(vorticity_confinement),
         no_slip,
         threads: count(field!(threads)),
         backend,

@@ -1,6 +1,6 @@
 //! Checks of [`Params`]: every field in its range; errors name the field and its value.
 
-use super::{Params, check_step};
+use super::{MAX_VORTICITY_CONFINEMENT, Params, check_step};
 use crate::Error;
 
 impl Params {
@@ -68,6 +68,15 @@ impl Params {
                 "kinematic_viscosity",
                 self.kinematic_viscosity,
                 "must be finite and not negative (m²/s; 0 turns it off)",
+            ));
+        }
+        if !(self.vorticity_confinement.is_finite()
+            && (0.0..=MAX_VORTICITY_CONFINEMENT).contains(&self.vorticity_confinement))
+        {
+            return Err(Error::invalid(
+                "vorticity_confinement",
+                self.vorticity_confinement,
+                &format!("must lie in [0, {MAX_VORTICITY_CONFINEMENT}] (0 turns it off)"),
             ));
         }
         if !(self.density_tolerance.is_finite() && (0.0..1.0).contains(&self.density_tolerance)) {

@@ -54,6 +54,7 @@ struct SceneFile {
     time: Option<TimeFile>,
     viscosity: Option<f64>,
     kinematic_viscosity: Option<f64>,
+    vorticity_confinement: Option<f64>,
     no_slip: Option<bool>,
     threads: Option<usize>,
     backend: Option<Backend>,
@@ -217,6 +218,7 @@ impl SceneFile {
         p.gravity = self.gravity.unwrap_or(p.gravity);
         set(&mut p.viscosity, self.viscosity);
         set(&mut p.kinematic_viscosity, self.kinematic_viscosity);
+        set(&mut p.vorticity_confinement, self.vorticity_confinement);
         p.no_slip = self.no_slip.unwrap_or(p.no_slip);
         p.threads = self.threads.unwrap_or(p.threads);
         p.backend = self.backend.unwrap_or(p.backend);
@@ -351,6 +353,7 @@ impl SceneFile {
             }),
             viscosity: Some(p.viscosity),
             kinematic_viscosity: Some(p.kinematic_viscosity),
+            vorticity_confinement: Some(p.vorticity_confinement),
             no_slip: Some(p.no_slip),
             threads: Some(p.threads),
             backend: Some(p.backend),

@@ -151,6 +151,9 @@ impl World {
         if self.params.kinematic_viscosity > 0.0 {
             return refuse("the physical viscosity (kinematic_viscosity)");
         }
+        if self.params.vorticity_confinement > 0.0 {
+            return refuse("vorticity confinement (vorticity_confinement)");
+        }
         if !self.materials.single() {
             return refuse("several fluid materials");
         }

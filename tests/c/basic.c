@@ -173,6 +173,7 @@ int main(int argc, char **argv) {
     CHECK(params.coarse_correction == 0);
     CHECK(params.kinematic_viscosity == 0.0 && params.no_slip == 1);
     CHECK(params.backend == PF_BACKEND_CPU);
+    CHECK(params.vorticity_confinement == 0.0);
     params.threads = 2;
     OK(pf_params_validate(&params));
 
@@ -223,6 +224,14 @@ int main(int argc, char **argv) {
     pf_world_destroy(plain);
     OK(pf_params_calm(&honey));
     CHECK(honey.kinematic_viscosity == 1e-2 && honey.no_slip == 0);
+
+    /* Vorticity confinement, the last field, is kept by the world. */
+    PfParams swirl = params;
+    swirl.vorticity_confinement = 0.3;
+    OK(pf_world_create(&swirl, &plain));
+    OK(pf_world_get_params(plain, &back));
+    CHECK(back.vorticity_confinement == 0.3);
+    pf_world_destroy(plain);
 
     const float lo[3] = {-0.00625f, -0.00625f, -0.00625f};
     const float hi[3] = {0.40625f, 0.40625f, 0.30625f};

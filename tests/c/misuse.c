@@ -133,6 +133,12 @@ int main(void) {
     p.no_slip = 2;
     bad_params(p, "params->no_slip must be 0 or 1, got 2");
     p = params;
+    p.vorticity_confinement = NAN;
+    bad_params(p, "params->vorticity_confinement must lie in [0, 10]");
+    p = params;
+    p.vorticity_confinement = -0.5;
+    bad_params(p, "params->vorticity_confinement must lie in [0, 10]");
+    p = params;
     p.backend = 2;
     bad_params(p, "params->backend must be PF_BACKEND_CPU (0) or PF_BACKEND_GPU (1), got 2");
     p = params;

@@ -1,6 +1,6 @@
 """The C library: finding and loading it, mirrors of its structs, its functions' signatures.
 
-Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 5); the rest of the
+Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 6); the rest of the
 package calls the C API only through :data:`lib`. ctypes releases the GIL during every
 foreign call, so long calls such as ``pf_world_advance`` let other Python threads run.
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 #: The binary interface these declarations were written for (``PF_ABI_VERSION``).
-ABI_VERSION = 5
+ABI_VERSION = 6
 
 
 def library_file_name() -> str:
@@ -81,6 +81,7 @@ class PfParams(ctypes.Structure):
         ("kinematic_viscosity", c_double),
         ("no_slip", c_uint32),
         ("backend", c_uint32),
+        ("vorticity_confinement", c_double),
     ]
 
 

@@ -167,6 +167,9 @@ class Params:
     (single precision on a Vulkan device, in a library built with the ``gpu`` feature). A
     world on the GPU refuses bodies, emitters, walls built as fields, further materials, the
     physical viscosity and solvers other than ``chebyshev`` and ``jacobi1``."""
+    vorticity_confinement: float = _C_DEFAULTS.vorticity_confinement
+    """Vorticity confinement coefficient ε in [0, 10] (0 = off, the default): gives back
+    rotation that the solver and XSPH damp; 0.1–1 is a useful range."""
 
     def __post_init__(self) -> None:
         for field in dataclasses.fields(self):

@@ -51,7 +51,7 @@ fn every_key_is_read() {
                        "max_iterations": 50, "min_iterations": 2, "projection_weight": "unit"},
             "time": {"cfl_factor": 0.4, "dt_min": 1e-5, "dt_max": 1e-2, "dt_initial": 2e-3},
             "viscosity": 0.02, "kinematic_viscosity": 1e-4, "no_slip": false,
-            "threads": 2, "backend": "gpu", "duration": 3,
+            "vorticity_confinement": 0.4, "threads": 2, "backend": "gpu", "duration": 3,
             "output": {"dir": "frames", "every": 5, "fps": 25}
         }"#;
     let s = Scene::from_json(text).unwrap();
@@ -82,6 +82,7 @@ fn every_key_is_read() {
     );
     assert_eq!((p.viscosity, p.threads), (0.02, 2));
     assert_eq!(p.kinematic_viscosity, 1e-4);
+    assert_eq!(p.vorticity_confinement, 0.4);
     assert!(!p.no_slip);
     assert_eq!(p.backend, crate::Backend::Gpu);
     assert_eq!(s.containers[0].layers, 2);

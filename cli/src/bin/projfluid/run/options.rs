@@ -33,6 +33,10 @@ pub(crate) struct ParamOptions {
     /// off; water 1e-6, honey 1e-2).
     #[arg(long, value_name = "NU", allow_negative_numbers = true)]
     pub(crate) kinematic_viscosity: Option<f64>,
+    /// Vorticity confinement ε in [0, 10], giving back rotation the solver and XSPH damp
+    /// (0 turns it off; 0.1–1 is a useful range).
+    #[arg(long, value_name = "EPSILON", allow_negative_numbers = true)]
+    pub(crate) vorticity_confinement: Option<f64>,
     /// Whether walls, static obstacles and static bodies hold the fluid with no slip under the
     /// physical viscosity (`on`, the default) or let it slide (`off`).
     #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
@@ -64,6 +68,9 @@ impl ParamOptions {
         if let Some(nu) = self.kinematic_viscosity {
             p.kinematic_viscosity = nu;
         }
+        if let Some(epsilon) = self.vorticity_confinement {
+            p.vorticity_confinement = epsilon;
+        }
         if let Some(on) = self.no_slip {
             p.no_slip = on;
         }
@@ -73,7 +80,7 @@ impl ParamOptions {
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 8] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 9] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
             ("solver.eta", "--eta", self.eta.is_some()),
@@ -92,6 +99,11 @@ impl ParamOptions {
                 "kinematic_viscosity",
                 "--kinematic-viscosity",
                 self.kinematic_viscosity.is_some(),
+            ),
+            (
+                "vorticity_confinement",
+                "--vorticity-confinement",
+                self.vorticity_confinement.is_some(),
             ),
             ("no_slip", "--no-slip", self.no_slip.is_some()),
             ("threads", "--threads", self.threads.is_some()),

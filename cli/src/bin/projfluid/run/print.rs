@@ -37,6 +37,13 @@ pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
                 format!("off ({walls} walls)")
             }
         }),
+        ("vorticity confinement", {
+            if s.vorticity_confinement > 0.0 {
+                format!("ε = {}", s.vorticity_confinement)
+            } else {
+                "off".to_string()
+            }
+        }),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),
         ("boundary particles", s.boundary_particles.to_string()),

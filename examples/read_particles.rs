@@ -44,13 +44,9 @@ fn main() -> Result<(), projfluid::Error> {
     );
 
     if let Some(path) = std::env::args().nth(1) {
-        projfluid::io::vtk::write_vtk(
-            std::path::Path::new(&path),
-            world.time(),
-            &world.positions(),
-            &world.velocities(),
-            &world.densities(),
-        )?;
+        let (x, v, rho) = (world.positions(), world.velocities(), world.densities());
+        let frame = projfluid::io::Frame::new(world.time(), &x, &v, &rho);
+        projfluid::io::write_vtk(std::path::Path::new(&path), &frame)?;
         println!("wrote {path}");
     }
     Ok(())

@@ -189,6 +189,7 @@ fn short_run_writes_stats_and_frames() {
         "coarse_correction",
         "kinematic_viscosity",
         "no_slip",
+        "vorticity_confinement",
         "threads",
         "particles",
         "boundary_particles",
@@ -215,6 +216,7 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(json["coarse_correction"], false);
     assert_eq!(json["kinematic_viscosity"], 0.0);
     assert_eq!(json["no_slip"], true);
+    assert_eq!(json["vorticity_confinement"], 0.0);
     assert_eq!(json["nan"], 0);
 
     let mut names: Vec<String> = std::fs::read_dir(&frames)
@@ -240,6 +242,48 @@ fn short_run_writes_stats_and_frames() {
         last.contains("<Piece NumberOfPoints=\"3840\""),
         "{last:.400}"
     );
+    // One liquid: no material array.
+    assert!(!last.contains("Name=\"material\""));
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// The frames of a scene with several liquids hold each particle's material.
+#[test]
+fn frames_of_several_liquids_hold_the_materials() {
+    let dir = temp_dir("frames-materials");
+    let frames = dir.join("frames");
+    let out = projfluid(&[
+        "run",
+        "oil_on_water",
+        "--steps",
+        "1",
+        "--threads",
+        "2",
+        "--out",
+        frames.to_str().unwrap(),
+        "--format",
+        "vtk-ascii",
+    ]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = std::fs::read_to_string(frames.join("frame_00000.vtk")).unwrap();
+    let at = text
+        .find("SCALARS material int 1")
+        .expect("a material array");
+    let ids: Vec<&str> = text[at..]
+        .lines()
+        .skip(2)
+        .filter(|l| !l.trim().is_empty())
+        .collect();
+    assert!(
+        ids.iter().all(|l| ["0", "1"].contains(&l.trim())),
+        "{ids:?}"
+    );
+    assert!(ids.iter().any(|l| l.trim() == "0") && ids.iter().any(|l| l.trim() == "1"));
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
@@ -1033,7 +1077,7 @@ fn ply_frames_hold_every_particle_with_velocity_and_density() {
         String::from_utf8_lossy(&out.stderr)
     );
     let bytes = std::fs::read(frames.join("frame_00001.ply")).unwrap();
-    assert!(!frames.join("frame_00001.vtk").exists());
+    assert!(!frames.join("frame_00000.vtk").exists());
     let end = b"end_header\n";
     let split = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
     let header = std::str::from_utf8(&bytes[..split]).unwrap();

@@ -1,5 +1,5 @@
-//! Readers and writers: frames as VTK XML (`.vtp`, with a `.pvd` collection for the time
-//! series), legacy VTK and PLY; OBJ meshes.
+//! Readers and writers: frames ([`Frame`]) as VTK XML (`.vtp`, with a `.pvd` collection for
+//! the time series), legacy VTK and PLY; OBJ meshes.
 
 pub mod obj;
 pub mod ply;
@@ -13,7 +13,7 @@ pub use pvd::{PvdDataSet, write_pvd};
 pub use vtk::{VtkEncoding, write_vtk, write_vtk_encoded};
 pub use vtp::write_vtp;
 
-use crate::{Error, Vec3};
+use crate::{Error, MaterialId, Vec3};
 use std::ffi::OsString;
 use std::path::Path;
 
@@ -38,27 +38,75 @@ pub fn write_atomically(path: &Path, bytes: &[u8]) -> Result<(), Error> {
     })
 }
 
-/// Checks that a frame's simulated `time` (s) is finite and that it has one velocity and one
-/// density per position (`n` of them); errors name the argument at fault.
-fn check_frame(time: f64, n: usize, velocities: &[Vec3], densities: &[f64]) -> Result<(), Error> {
-    if !time.is_finite() {
-        return Err(Error::invalid("time", time, "must be finite"));
-    }
-    for (name, len) in [
-        ("velocities", velocities.len()),
-        ("densities", densities.len()),
-    ] {
-        if len != n {
-            return Err(Error::invalid(
-                name,
-                len,
-                &format!("must have one entry per position ({n})"),
-            ));
-        }
-    }
-    Ok(())
+/// One frame's particles: what the frame writers ([`write_vtp`], [`write_vtk`],
+/// [`write_ply`]) store.
+#[derive(Clone, Copy, Debug)]
+pub struct Frame<'a> {
+    /// Simulated time (s).
+    pub time: f64,
+    /// Particle centres (m).
+    pub positions: &'a [Vec3],
+    /// Velocities (m/s), one per position.
+    pub velocities: &'a [Vec3],
+    /// Densities (kg/m³), one per position.
+    pub densities: &'a [f64],
+    /// Each particle's material (docs/method.md §14), one per position; empty leaves the
+    /// `material` array out of the file, as a world of one liquid does.
+    pub materials: &'a [MaterialId],
 }
 
+impl<'a> Frame<'a> {
+    /// A frame of one liquid at simulated time `time` (s).
+    pub fn new(
+        time: f64,
+        positions: &'a [Vec3],
+        velocities: &'a [Vec3],
+        densities: &'a [f64],
+    ) -> Self {
+        Self {
+            time,
+            positions,
+            velocities,
+            densities,
+            materials: &[],
+        }
+    }
+
+    /// The frame with each particle's material.
+    pub fn with_materials(self, materials: &'a [MaterialId]) -> Self {
+        Self { materials, ..self }
+    }
+
+    /// Checks that the time is finite and that there is one velocity, one density and (where
+    /// given) one material per position; errors name the field at fault.
+    fn check(&self) -> Result<(), Error> {
+        if !self.time.is_finite() {
+            return Err(Error::invalid("time", self.time, "must be finite"));
+        }
+        let n = self.positions.len();
+        for (name, len) in [
+            ("velocities", self.velocities.len()),
+            ("densities", self.densities.len()),
+            (
+                "materials",
+                if self.materials.is_empty() {
+                    n
+                } else {
+                    self.materials.len()
+                },
+            ),
+        ] {
+            if len != n {
+                return Err(Error::invalid(
+                    name,
+                    len,
+                    &format!("must have one entry per position ({n})"),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
 /// A frame of three particles whose values exercise signs, zeros and small magnitudes, for the
 /// writers' read-back tests: positions (m), velocities (m/s) and densities (kg/m³).
 #[cfg(test)]

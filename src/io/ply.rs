@@ -1,44 +1,56 @@
 //! Frames as PLY point clouds (binary little-endian), readable by Blender, MeshLab and
 //! CloudCompare: the simulated time in a header comment `comment time T` (s, printed so that
 //! it reads back exactly), and one `vertex` element per particle with `float` properties
-//! `x y z` (m), `vx vy vz` (m/s) and `density` (kg/m³).
+//! `x y z` (m), `vx vy vz` (m/s) and `density` (kg/m³), and a `ushort` property `material`
+//! where the frame has several liquids.
 
-use crate::{Error, Vec3};
+use super::Frame;
+use crate::Error;
 use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Writes one frame at simulated time `time` (s): `positions` (m), `velocities` (m/s) and
-/// `densities` (kg/m³), one entry per particle, as little-endian 32-bit floats. Creates or
-/// truncates `path`. Errors name the path, or the argument whose length differs from
-/// `positions`, or a time that is not finite.
-pub fn write_ply(
-    path: &Path,
-    time: f64,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> Result<(), Error> {
-    super::check_frame(time, positions.len(), velocities, densities)?;
+/// Writes `frame`: positions, velocities and densities as little-endian 32-bit floats, and
+/// materials (where it has them) as 16-bit unsigned integers. Creates or truncates `path`.
+/// Errors name the path, or the field whose length differs from the positions', or a time
+/// that is not finite.
+pub fn write_ply(path: &Path, frame: &Frame) -> Result<(), Error> {
+    frame.check()?;
     let fail = |e: std::io::Error| Error::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = BufWriter::new(File::create(path).map_err(fail)?);
+    let with_materials = !frame.materials.is_empty();
     write!(
         w,
-        "ply\nformat binary_little_endian 1.0\ncomment projfluid frame\ncomment time {time}\n\
+        "ply\nformat binary_little_endian 1.0\ncomment projfluid frame\ncomment time {}\n\
          element vertex {}\n\
          property float x\nproperty float y\nproperty float z\n\
          property float vx\nproperty float vy\nproperty float vz\n\
-         property float density\nend_header\n",
-        positions.len()
+         property float density\n{}end_header\n",
+        frame.time,
+        frame.positions.len(),
+        if with_materials {
+            "property ushort material\n"
+        } else {
+            ""
+        }
     )
     .map_err(fail)?;
-    for ((x, v), &rho) in positions.iter().zip(velocities).zip(densities) {
+    let records = frame
+        .positions
+        .iter()
+        .zip(frame.velocities)
+        .zip(frame.densities);
+    for (k, ((x, v), &rho)) in records.enumerate() {
         let mut record = [0u8; 28];
         let values = [x.x, x.y, x.z, v.x, v.y, v.z, rho];
         for (chunk, value) in record.chunks_exact_mut(4).zip(values) {
             chunk.copy_from_slice(&(value as f32).to_le_bytes());
         }
         w.write_all(&record).map_err(fail)?;
+        if with_materials {
+            w.write_all(&frame.materials[k].to_le_bytes())
+                .map_err(fail)?;
+        }
     }
     w.flush().map_err(fail)
 }
@@ -46,6 +58,7 @@ pub fn write_ply(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::Vec3;
 
     /// Reads exactly the files `write_ply` writes: the header lines and the records.
     fn read_ply(bytes: &[u8]) -> (Vec<String>, Vec<[f32; 7]>) {
@@ -78,7 +91,11 @@ mod tests {
         let densities = vec![1000.0, 998.25];
         let path = std::env::temp_dir().join(format!("projfluid-ply-{}.ply", std::process::id()));
         let time = 0.1 + 0.2;
-        write_ply(&path, time, &positions, &velocities, &densities).unwrap();
+        write_ply(
+            &path,
+            &Frame::new(time, &positions, &velocities, &densities),
+        )
+        .unwrap();
         let bytes = std::fs::read(&path).unwrap();
         std::fs::remove_file(&path).unwrap();
         let (header, records) = read_ply(&bytes);
@@ -112,12 +129,35 @@ mod tests {
     #[test]
     fn bad_lengths_and_paths_are_named() {
         let p = [Vec3::zeros(); 2];
-        let err = write_ply(Path::new("/tmp/x.ply"), 0.0, &p, &p, &[0.0]).unwrap_err();
+        let err = write_ply(Path::new("/tmp/x.ply"), &Frame::new(0.0, &p, &p, &[0.0])).unwrap_err();
         assert_eq!(
             err.to_string(),
             "densities must have one entry per position (2), got 1"
         );
-        let err = write_ply(Path::new("/nonexistent/f.ply"), 0.0, &[], &[], &[]).unwrap_err();
+        let err = write_ply(
+            Path::new("/nonexistent/f.ply"),
+            &Frame::new(0.0, &[], &[], &[]),
+        )
+        .unwrap_err();
         assert!(err.to_string().contains("/nonexistent/f.ply"), "{err}");
+    }
+
+    /// A frame with materials adds a `ushort material` property after `density`.
+    #[test]
+    fn materials_are_a_property_of_each_vertex() {
+        let positions = vec![Vec3::new(0.1, 0.2, 0.3), Vec3::new(-1.5, 2.25, 1e-7)];
+        let path = std::env::temp_dir().join(format!("projfluid-ply-m-{}.ply", std::process::id()));
+        let frame = Frame::new(0.0, &positions, &positions, &[1000.0, 800.0]);
+        write_ply(&path, &frame.with_materials(&[3, 1])).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let end = b"end_header\n";
+        let split = bytes.windows(end.len()).position(|w| w == end).unwrap() + end.len();
+        let header = std::str::from_utf8(&bytes[..split]).unwrap();
+        assert!(header.ends_with("property float density\nproperty ushort material\nend_header\n"));
+        let body = &bytes[split..];
+        assert_eq!(body.len(), 2 * 30);
+        assert_eq!(u16::from_le_bytes([body[28], body[29]]), 3);
+        assert_eq!(u16::from_le_bytes([body[58], body[59]]), 1);
     }
 }

@@ -1,9 +1,11 @@
 //! Frames as legacy VTK files, readable by ParaView and VisIt: `DATASET POLYDATA` with the
 //! simulated time as a `TIME` field (which ParaView and VisIt read as the frame's time), the
 //! particle centres as `POINTS`, one vertex cell per particle (so the points render), and
-//! per-point `velocity` (m/s) and `density` (kg/m³). Binary files store big-endian `float`s
-//! (the time as a `double`); ASCII files write the same values as text.
+//! per-point `velocity` (m/s), `density` (kg/m³) and, where the frame has several liquids,
+//! `material` (`int`). Binary files store big-endian `float`s and `int`s (the time as a
+//! `double`); ASCII files write the same values as text.
 
+use super::Frame;
 use crate::{Error, Vec3};
 use std::fs::File;
 use std::io::{BufWriter, Write};
@@ -18,38 +20,18 @@ pub enum VtkEncoding {
     Ascii,
 }
 
-/// Writes one binary frame at simulated time `time` (s): `positions` (m), `velocities`
-/// (m/s) and `densities` (kg/m³), one entry per particle, stored as big-endian 32-bit
-/// floats. Creates or truncates `path`. Errors name the path, or the argument whose length
-/// differs from `positions`, or a time that is not finite.
-pub fn write_vtk(
-    path: &Path,
-    time: f64,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> Result<(), Error> {
-    write_vtk_encoded(
-        path,
-        VtkEncoding::Binary,
-        time,
-        positions,
-        velocities,
-        densities,
-    )
+/// Writes `frame` in binary: positions, velocities and densities stored as big-endian 32-bit
+/// floats, materials (where it has them) as 32-bit integers. Creates or truncates `path`.
+/// Errors name the path, or the field whose length differs from the positions', or a time
+/// that is not finite.
+pub fn write_vtk(path: &Path, frame: &Frame) -> Result<(), Error> {
+    write_vtk_encoded(path, VtkEncoding::Binary, frame)
 }
 
 /// [`write_vtk`] with the numbers stored as `encoding` says.
-pub fn write_vtk_encoded(
-    path: &Path,
-    encoding: VtkEncoding,
-    time: f64,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> Result<(), Error> {
-    let n = positions.len();
-    super::check_frame(time, n, velocities, densities)?;
+pub fn write_vtk_encoded(path: &Path, encoding: VtkEncoding, frame: &Frame) -> Result<(), Error> {
+    frame.check()?;
+    let n = frame.positions.len();
     if n > (i32::MAX / 2) as usize {
         return Err(Error::invalid(
             "positions",
@@ -60,31 +42,24 @@ pub fn write_vtk_encoded(
     let fail = |e: std::io::Error| Error::Io(format!("cannot write {}: {e}", path.display()));
     let file = File::create(path).map_err(fail)?;
     let mut w = BufWriter::new(file);
-    let mut frame = Frame {
+    let mut writer = Writer {
         w: &mut w,
         encoding,
     };
-    frame
-        .write(time, positions, velocities, densities)
-        .map_err(fail)?;
+    writer.write(frame).map_err(fail)?;
     w.flush().map_err(fail)
 }
 
 /// A frame being written in one encoding.
-struct Frame<'a, W: Write> {
+struct Writer<'a, W: Write> {
     w: &'a mut W,
     encoding: VtkEncoding,
 }
 
-impl<W: Write> Frame<'_, W> {
+impl<W: Write> Writer<'_, W> {
     /// The file's bytes, in order.
-    fn write(
-        &mut self,
-        time: f64,
-        positions: &[Vec3],
-        velocities: &[Vec3],
-        densities: &[f64],
-    ) -> std::io::Result<()> {
+    fn write(&mut self, frame: &Frame) -> std::io::Result<()> {
+        let (time, positions) = (frame.time, frame.positions);
         let n = positions.len();
         let name = match self.encoding {
             VtkEncoding::Binary => "BINARY",
@@ -108,11 +83,18 @@ impl<W: Write> Frame<'_, W> {
             self.separate()?;
         }
         write!(self.w, "\nPOINT_DATA {n}\nVECTORS velocity float\n")?;
-        self.vectors(velocities)?;
+        self.vectors(frame.velocities)?;
         write!(self.w, "\nSCALARS density float 1\nLOOKUP_TABLE default\n")?;
-        for &d in densities {
+        for &d in frame.densities {
             self.float(d)?;
             self.separate()?;
+        }
+        if !frame.materials.is_empty() {
+            write!(self.w, "\nSCALARS material int 1\nLOOKUP_TABLE default\n")?;
+            for &m in frame.materials {
+                self.int(i32::from(m))?;
+                self.separate()?;
+            }
         }
         writeln!(self.w)
     }
@@ -157,6 +139,7 @@ impl<W: Write> Frame<'_, W> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::Frame;
     use std::path::PathBuf;
 
     /// A reader for exactly the files `write_vtk` writes.
@@ -205,7 +188,11 @@ mod tests {
         let (positions, velocities, densities) = super::super::sample_frame();
         let path = temp_path("frame.vtk");
         let time = 0.1 + 0.2;
-        write_vtk(&path, time, &positions, &velocities, &densities).unwrap();
+        write_vtk(
+            &path,
+            &Frame::new(time, &positions, &velocities, &densities),
+        )
+        .unwrap();
         let mut r = Reader {
             bytes: std::fs::read(&path).unwrap(),
             at: 0,
@@ -246,19 +233,27 @@ mod tests {
     #[test]
     fn mismatched_lengths_are_rejected() {
         let p = [Vec3::zeros(); 2];
-        let err = write_vtk(&temp_path("bad.vtk"), 0.0, &p, &p[..1], &[0.0; 2]).unwrap_err();
+        let err = write_vtk(
+            &temp_path("bad.vtk"),
+            &Frame::new(0.0, &p, &p[..1], &[0.0; 2]),
+        )
+        .unwrap_err();
         assert_eq!(
             err.to_string(),
             "velocities must have one entry per position (2), got 1"
         );
-        let err = write_vtk(&temp_path("bad.vtk"), f64::NAN, &p, &p, &[0.0; 2]).unwrap_err();
+        let err = write_vtk(
+            &temp_path("bad.vtk"),
+            &Frame::new(f64::NAN, &p, &p, &[0.0; 2]),
+        )
+        .unwrap_err();
         assert_eq!(err.to_string(), "time must be finite, got NaN");
     }
 
     #[test]
     fn unwritable_path_is_named() {
         let path = Path::new("/nonexistent-dir/frame.vtk");
-        let err = write_vtk(path, 0.0, &[], &[], &[]).unwrap_err();
+        let err = write_vtk(path, &Frame::new(0.0, &[], &[], &[])).unwrap_err();
         assert!(
             err.to_string().contains("/nonexistent-dir/frame.vtk"),
             "{err}"
@@ -275,7 +270,12 @@ mod tests {
         let path = temp_path("ascii.vtk");
         let time = 1.0 / 3.0;
         let encoding = VtkEncoding::Ascii;
-        write_vtk_encoded(&path, encoding, time, &positions, &velocities, &densities).unwrap();
+        write_vtk_encoded(
+            &path,
+            encoding,
+            &Frame::new(time, &positions, &velocities, &densities),
+        )
+        .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         std::fs::remove_file(&path).unwrap();
         let mut lines = text.lines().filter(|l| !l.trim().is_empty());
@@ -309,5 +309,24 @@ mod tests {
         assert_eq!(numbers(rest[13]), [1000.0]);
         assert_eq!(numbers(rest[14]), [998.25]);
         assert_eq!(rest.len(), 15);
+    }
+
+    /// A frame with materials ends with an `int` scalar `material`, one per point.
+    #[test]
+    fn materials_follow_the_densities() {
+        let positions = vec![Vec3::zeros(), Vec3::new(1.0, 0.0, 0.0)];
+        let path = temp_path("materials.vtk");
+        let frame = Frame::new(0.0, &positions, &positions, &[1000.0, 800.0]);
+        write_vtk_encoded(&path, VtkEncoding::Ascii, &frame.with_materials(&[0, 1])).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::remove_file(&path).unwrap();
+        let lines: Vec<&str> = text.lines().filter(|l| !l.trim().is_empty()).collect();
+        let at = lines
+            .iter()
+            .position(|l| *l == "SCALARS material int 1")
+            .expect("a material array");
+        assert_eq!(lines[at + 1], "LOOKUP_TABLE default");
+        assert_eq!((lines[at + 2].trim(), lines[at + 3].trim()), ("0", "1"));
+        assert_eq!(lines.len(), at + 4);
     }
 }

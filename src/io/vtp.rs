@@ -10,8 +10,10 @@
 //! docs.vtk.org), so that a series of these files opened without its `.pvd` still has true
 //! times. Then the particle centres as Float32 `Points` (m), one vertex cell per particle
 //! (Int32 `Verts` connectivity and offsets, so that the points render), and per-point Float32
-//! `velocity` (m/s, three components) and `density` (kg/m³): the arrays of the legacy frames.
+//! `velocity` (m/s, three components) and `density` (kg/m³), and UInt16 `material` where the
+//! frame has several liquids: the arrays of the legacy frames.
 
+use super::Frame;
 use crate::{Error, Vec3};
 use base64::engine::general_purpose::STANDARD;
 use base64::write::EncoderWriter;
@@ -19,20 +21,14 @@ use std::fs::File;
 use std::io::{BufWriter, Write};
 use std::path::Path;
 
-/// Writes one frame at simulated time `time` (s): `positions` (m), `velocities` (m/s) and
-/// `densities` (kg/m³), one entry per particle, stored as little-endian 32-bit floats, the
-/// time as a 64-bit one. The same arguments give the same bytes. Creates or truncates
-/// `path`. Errors name the path, or the argument whose length differs from `positions`, or a
-/// time that is not finite.
-pub fn write_vtp(
-    path: &Path,
-    time: f64,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> Result<(), Error> {
-    let n = positions.len();
-    super::check_frame(time, n, velocities, densities)?;
+/// Writes `frame`: positions, velocities, densities and materials (where it has them)
+/// stored as little-endian 32-bit floats (the materials as 16-bit unsigned integers), the time
+/// as a 64-bit float. The same frame gives the same bytes. Creates or truncates `path`.
+/// Errors name the path, or the field whose length differs from the positions', or a time
+/// that is not finite.
+pub fn write_vtp(path: &Path, frame: &Frame) -> Result<(), Error> {
+    frame.check()?;
+    let n = frame.positions.len();
     // The vertex offsets run to n and are stored as Int32.
     if n > i32::MAX as usize {
         return Err(Error::invalid(
@@ -43,18 +39,13 @@ pub fn write_vtp(
     }
     let fail = |e: std::io::Error| Error::Io(format!("cannot write {}: {e}", path.display()));
     let mut w = BufWriter::new(File::create(path).map_err(fail)?);
-    write_frame(&mut w, time, positions, velocities, densities).map_err(fail)?;
+    write_frame(&mut w, frame).map_err(fail)?;
     w.flush().map_err(fail)
 }
 
 /// The file's text and data, in order.
-fn write_frame<W: Write>(
-    w: &mut W,
-    time: f64,
-    positions: &[Vec3],
-    velocities: &[Vec3],
-    densities: &[f64],
-) -> std::io::Result<()> {
+fn write_frame<W: Write>(w: &mut W, frame: &Frame) -> std::io::Result<()> {
+    let (positions, velocities, densities) = (frame.positions, frame.velocities, frame.densities);
     let n = positions.len();
     write!(
         w,
@@ -62,7 +53,7 @@ fn write_frame<W: Write>(
          <VTKFile type=\"PolyData\" version=\"1.0\" byte_order=\"LittleEndian\" \
          header_type=\"UInt64\">\n  <PolyData>\n    <FieldData>\n"
     )?;
-    let time = time.to_le_bytes();
+    let time = frame.time.to_le_bytes();
     for name in ["TIME", "TimeValue"] {
         let attributes = format!("type=\"Float64\" Name=\"{name}\" NumberOfTuples=\"1\"");
         data_array(w, FIELD, &attributes, &time)?;
@@ -78,6 +69,14 @@ fn write_frame<W: Write>(
     data_array(w, PIECE, &attributes, &f32_bytes(components(velocities)))?;
     let attributes = "type=\"Float32\" Name=\"density\"";
     data_array(w, PIECE, attributes, &f32_bytes(densities.iter().copied()))?;
+    if !frame.materials.is_empty() {
+        let bytes: Vec<u8> = frame
+            .materials
+            .iter()
+            .flat_map(|m| m.to_le_bytes())
+            .collect();
+        data_array(w, PIECE, "type=\"UInt16\" Name=\"material\"", &bytes)?;
+    }
     write!(w, "      </PointData>\n      <Points>\n")?;
     let attributes = format!("type=\"Float32\" Name=\"Points\" {vector}");
     data_array(w, PIECE, &attributes, &f32_bytes(components(positions)))?;
@@ -148,6 +147,7 @@ fn i32_bytes(values: impl Iterator<Item = i32>) -> Vec<u8> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::Frame;
     use base64::Engine;
     use std::path::PathBuf;
 
@@ -199,7 +199,11 @@ mod tests {
         let (positions, velocities, densities) = super::super::sample_frame();
         let path = temp_path("frame.vtp");
         let time = 0.1 + 0.2;
-        write_vtp(&path, time, &positions, &velocities, &densities).unwrap();
+        write_vtp(
+            &path,
+            &Frame::new(time, &positions, &velocities, &densities),
+        )
+        .unwrap();
         let text = std::fs::read_to_string(&path).unwrap();
         std::fs::remove_file(&path).unwrap();
         let doc = roxmltree::Document::parse(&text).unwrap();
@@ -248,6 +252,27 @@ mod tests {
         }
     }
 
+    /// A frame with materials holds them as a UInt16 `material` array after `density`; one
+    /// material too few is refused, naming the field.
+    #[test]
+    fn materials_are_an_array_of_their_own() {
+        let (positions, velocities, densities) = super::super::sample_frame();
+        let path = temp_path("materials.vtp");
+        let frame = Frame::new(0.5, &positions, &velocities, &densities);
+        write_vtp(&path, &frame.with_materials(&[0, 2, 1])).unwrap();
+        let text = std::fs::read_to_string(&path).unwrap();
+        let doc = roxmltree::Document::parse(&text).unwrap();
+        let bytes = array_bytes(&doc, "PointData", "material");
+        let ids: Vec<u16> = bytes
+            .chunks_exact(2)
+            .map(|b| u16::from_le_bytes([b[0], b[1]]))
+            .collect();
+        assert_eq!(ids, [0, 2, 1]);
+        let err = write_vtp(&path, &frame.with_materials(&[0, 1])).unwrap_err();
+        std::fs::remove_file(&path).unwrap();
+        assert!(err.to_string().contains("materials"), "{err}");
+    }
+
     /// Two writes of the same frame give the same bytes; a frame without particles is still
     /// a valid file with empty arrays.
     #[test]
@@ -255,12 +280,12 @@ mod tests {
         let positions = [Vec3::new(0.5, 0.25, 0.125), Vec3::new(1.0, 2.0, 3.0)];
         let (a, b) = (temp_path("a.vtp"), temp_path("b.vtp"));
         for path in [&a, &b] {
-            write_vtp(path, 2.5, &positions, &positions, &[1.0, 2.0]).unwrap();
+            write_vtp(path, &Frame::new(2.5, &positions, &positions, &[1.0, 2.0])).unwrap();
         }
         let (bytes_a, bytes_b) = (std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
         assert_eq!(bytes_a, bytes_b);
 
-        write_vtp(&a, 0.0, &[], &[], &[]).unwrap();
+        write_vtp(&a, &Frame::new(0.0, &[], &[], &[])).unwrap();
         let text = std::fs::read_to_string(&a).unwrap();
         for path in [&a, &b] {
             std::fs::remove_file(path).unwrap();
@@ -276,15 +301,18 @@ mod tests {
     fn bad_lengths_times_and_paths_are_named() {
         let p = [Vec3::zeros(); 2];
         let path = temp_path("bad.vtp");
-        let err = write_vtp(&path, 0.0, &p, &p[..1], &[0.0; 2]).unwrap_err();
+        let err = write_vtp(&path, &Frame::new(0.0, &p, &p[..1], &[0.0; 2])).unwrap_err();
         assert_eq!(
             err.to_string(),
             "velocities must have one entry per position (2), got 1"
         );
-        let err = write_vtp(&path, f64::INFINITY, &p, &p, &[0.0; 2]).unwrap_err();
+        let err = write_vtp(&path, &Frame::new(f64::INFINITY, &p, &p, &[0.0; 2])).unwrap_err();
         assert_eq!(err.to_string(), "time must be finite, got inf");
         assert!(!path.exists(), "a rejected frame writes nothing");
-        let err = write_vtp(Path::new("/nonexistent-dir/f.vtp"), 0.0, &[], &[], &[]);
+        let err = write_vtp(
+            Path::new("/nonexistent-dir/f.vtp"),
+            &Frame::new(0.0, &[], &[], &[]),
+        );
         let message = err.unwrap_err().to_string();
         assert!(message.contains("/nonexistent-dir/f.vtp"), "{message}");
     }

@@ -6,7 +6,8 @@
 use crate::Failure;
 use projfluid::World;
 use projfluid::io::{
-    PvdDataSet, VtkEncoding, write_atomically, write_ply, write_pvd, write_vtk_encoded, write_vtp,
+    Frame, PvdDataSet, VtkEncoding, write_atomically, write_ply, write_pvd, write_vtk_encoded,
+    write_vtp,
 };
 use projfluid_lab::render::Renderer;
 use std::path::{Path, PathBuf};
@@ -136,22 +137,20 @@ impl Frames {
     pub(crate) fn write(&mut self, world: &World) -> Result<(), Failure> {
         let name = frame_name(self.written);
         if let Some((dir, format)) = &self.data {
-            let (time, x, v, rho) = (
-                world.time(),
-                world.positions(),
-                world.velocities(),
-                world.densities(),
-            );
+            let (x, v, rho) = (world.positions(), world.velocities(), world.densities());
+            // Each particle's liquid, where the world has several.
+            let materials = if world.material_count() > 1 {
+                world.particle_materials()
+            } else {
+                Vec::new()
+            };
+            let frame = Frame::new(world.time(), &x, &v, &rho).with_materials(&materials);
             let path = dir.join(format!("{name}.{}", format.extension()));
             match format {
-                FrameFormat::Vtp => write_vtp(&path, time, &x, &v, &rho),
-                FrameFormat::Vtk => {
-                    write_vtk_encoded(&path, VtkEncoding::Binary, time, &x, &v, &rho)
-                }
-                FrameFormat::VtkAscii => {
-                    write_vtk_encoded(&path, VtkEncoding::Ascii, time, &x, &v, &rho)
-                }
-                FrameFormat::Ply => write_ply(&path, time, &x, &v, &rho),
+                FrameFormat::Vtp => write_vtp(&path, &frame),
+                FrameFormat::Vtk => write_vtk_encoded(&path, VtkEncoding::Binary, &frame),
+                FrameFormat::VtkAscii => write_vtk_encoded(&path, VtkEncoding::Ascii, &frame),
+                FrameFormat::Ply => write_ply(&path, &frame),
             }
             .map_err(|e| Failure::Runtime(e.to_string()))?;
         }

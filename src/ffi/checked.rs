@@ -6,7 +6,7 @@
 //! read or written.
 
 use super::params::{PfParams, read_params};
-use super::status::Failure;
+use super::status::{Failure, PfStatus};
 use super::world::PfWorld;
 use crate::{Params, World};
 use std::ffi::{CStr, c_char};
@@ -49,6 +49,32 @@ impl<'a> Args<'a> {
     /// accessed by no one else during the call); NUL-terminated strings.
     pub unsafe fn trusted() -> Self {
         Self(PhantomData)
+    }
+
+    /// The body of the per-particle reads: `want` values (named `unit` in the error, e.g.
+    /// `floats`) are needed; `*needed` (when not NULL; checked as `needed_name`) receives
+    /// `want` on success and on a short buffer; a buffer `out` of `capacity` values shorter
+    /// than `want` is `PF_ERROR_BUFFER_TOO_SMALL` and stays untouched; otherwise `write`
+    /// fills it.
+    pub fn per_particle<T>(
+        self,
+        out: *mut T,
+        capacity: usize,
+        (needed, needed_name): (*mut usize, &str),
+        (want, unit): (usize, &str),
+        write: impl FnOnce(&mut [T]) -> Result<(), usize>,
+    ) -> Result<(), Failure> {
+        if !needed.is_null() {
+            self.write(needed, want, needed_name)?;
+        }
+        let short = |message: String| Failure::new(PfStatus::PF_ERROR_BUFFER_TOO_SMALL, message);
+        if capacity < want {
+            return Err(short(format!(
+                "the buffer holds {capacity} {unit} but {want} are needed"
+            )));
+        }
+        let out = self.out_slice(out, capacity, "out")?;
+        write(out).map_err(|n| short(format!("{n}")))
     }
 
     /// The world behind the handle `p` (the argument `world`), locked for the call.

@@ -156,19 +156,10 @@ pub unsafe extern "C" fn pf_world_get_materials(
     status_call("pf_world_get_materials", || {
         let world = args.world(world)?;
         let want = world.fluid_count();
-        if !needed.is_null() {
-            args.write(needed, want, "needed")?;
-        }
-        if capacity < want {
-            return Err(Failure::new(
-                PfStatus::PF_ERROR_BUFFER_TOO_SMALL,
-                format!("the buffer holds {capacity} material ids but {want} are needed"),
-            ));
-        }
-        let out = args.out_slice(out, capacity, "out")?;
-        // The capacity was checked above.
-        let _ = world.write_materials(out);
-        Ok(())
+        let unit = "material ids";
+        args.per_particle(out, capacity, (needed, "needed"), (want, unit), |out| {
+            world.write_materials(out)
+        })
     })
 }
 

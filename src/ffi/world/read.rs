@@ -181,23 +181,18 @@ fn get(
             _ => 3,
         };
         let want = per_particle * world.fluid_count();
-        if !needed.is_null() {
-            // A misaligned `needed` is reported as `out`, as it always has been.
-            args.write(needed, want, "out")?;
-        }
-        if capacity < want {
-            return Err(Failure::new(
-                PfStatus::PF_ERROR_BUFFER_TOO_SMALL,
-                format!("the buffer holds {capacity} floats but {want} are needed"),
-            ));
-        }
-        let out = args.out_slice(out, capacity, "out")?;
-        let written = match quantity {
-            Quantity::Positions => world.write_positions_f32(out),
-            Quantity::Velocities => world.write_velocities_f32(out),
-            Quantity::Densities => world.write_densities_f32(out),
-        };
-        written.map_err(|n| Failure::new(PfStatus::PF_ERROR_BUFFER_TOO_SMALL, format!("{n}")))
+        // A misaligned `needed` is reported as `out`, as it always has been.
+        args.per_particle(
+            out,
+            capacity,
+            (needed, "out"),
+            (want, "floats"),
+            |out| match quantity {
+                Quantity::Positions => world.write_positions_f32(out),
+                Quantity::Velocities => world.write_velocities_f32(out),
+                Quantity::Densities => world.write_densities_f32(out),
+            },
+        )
     })
 }
 
@@ -302,19 +297,9 @@ pub unsafe extern "C" fn pf_world_get_ids(
     status_call("pf_world_get_ids", || {
         let world = args.world(world)?;
         let want = world.fluid_count();
-        if !needed.is_null() {
-            args.write(needed, want, "needed")?;
-        }
-        if capacity < want {
-            return Err(Failure::new(
-                PfStatus::PF_ERROR_BUFFER_TOO_SMALL,
-                format!("the buffer holds {capacity} ids but {want} are needed"),
-            ));
-        }
-        let out = args.out_slice(out, capacity, "out")?;
-        world
-            .write_ids(out)
-            .map_err(|n| Failure::new(PfStatus::PF_ERROR_BUFFER_TOO_SMALL, format!("{n}")))
+        args.per_particle(out, capacity, (needed, "needed"), (want, "ids"), |out| {
+            world.write_ids(out)
+        })
     })
 }
 

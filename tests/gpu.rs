@@ -257,6 +257,19 @@ fn unsupported_worlds_are_refused_naming_the_feature() {
         "{message}"
     );
     assert_eq!(world.backend(), Backend::Cpu);
+    // Vorticity confinement, refused when the GPU world is made.
+    let message = World::new(Params {
+        vorticity_confinement: 0.3,
+        backend: Backend::Gpu,
+        ..Params::default()
+    })
+    .err()
+    .expect("refused")
+    .to_string();
+    assert!(
+        message.contains("backend gpu") && message.contains("vorticity_confinement"),
+        "{message}"
+    );
 }
 
 /// Set for the run of [`missing_adapter_probe`] that

@@ -65,14 +65,8 @@ pub(super) fn check_flow(scene: &Scene) -> Result<(), Error> {
     let spacing = 2.0 * scene.params.particle_radius;
     for (i, emitter) in scene.emitters.iter().enumerate() {
         let spec = &emitter.spec;
-        let named = emitter.material.as_deref();
-        if let Some(name) = named.filter(|_| scene.material_named(named) == 0) {
-            return Err(Error::invalid(
-                format!("emitters[{i}].material"),
-                format!("{name:?}"),
-                "must name one of the scene's materials",
-            ));
-        }
+        let key = format!("emitters[{i}]");
+        super::validate::check_material_name(scene, &key, emitter.material.as_deref())?;
         let state = EmitterState {
             spec: *spec,
             travelled: spacing,

@@ -68,13 +68,7 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
     let mut total = 0usize;
     for (i, b) in scene.fluid_blocks.iter().enumerate() {
         check_block(i, b)?;
-        if let Some(name) = b.material.as_ref().filter(|_| scene.material_id(b) == 0) {
-            return Err(Error::invalid(
-                format!("fluid_blocks[{i}].material"),
-                format!("{name:?}"),
-                "must name one of the scene's materials",
-            ));
-        }
+        check_material_name(scene, &format!("fluid_blocks[{i}]"), b.material.as_deref())?;
         total = total.saturating_add(b.particle_count());
         if total > MAX_PARTICLES {
             return Err(Error::invalid(
@@ -87,6 +81,23 @@ pub(super) fn validate(scene: &Scene) -> Result<(), Error> {
     }
     super::flow::check_flow(scene)?;
     check_probes(scene)
+}
+
+/// A `material` key of the entry `key` (e.g. `emitters[0]`): absent, or the name of one of the
+/// scene's materials.
+pub(super) fn check_material_name(
+    scene: &Scene,
+    key: &str,
+    name: Option<&str>,
+) -> Result<(), Error> {
+    match name {
+        Some(name) if scene.material_named(Some(name)) == 0 => Err(Error::invalid(
+            format!("{key}.material"),
+            format!("{name:?}"),
+            "must name one of the scene's materials",
+        )),
+        _ => Ok(()),
+    }
 }
 
 /// The materials: unique, non-empty names and rest densities a world of the scene's rest

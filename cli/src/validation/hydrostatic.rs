@@ -31,6 +31,7 @@ pub use setup::Setup;
 
 use super::fit::{correlation, least_squares_slope};
 use projfluid::boundary::Aabb;
+use projfluid::pressure::ConstraintPressures;
 use projfluid::{Error, Vec3, World};
 
 /// Length of the pressure reading after the free run (s).
@@ -40,14 +41,14 @@ pub const READING_WINDOW: f64 = 0.25;
 pub const READING_TOLERANCE_PER_RADIUS: f64 = 1e-5;
 
 /// Mean estimated pressure of the particles in one horizontal layer of thickness d, over the
-/// steps of the last quarter second.
+/// steps of a reading ([`layer_profile`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layer {
     /// Mean height of the layer's particles above the floor plane (m).
     pub height: f64,
     /// Mean pressure estimate of its particles (Pa).
     pub pressure: f64,
-    /// ρ0·g·(H − y) at the layer's centre (Pa).
+    /// The hydrostatic pressure at the layer's mean height (Pa): ρ0·g·(H − y) for one liquid.
     pub hydrostatic: f64,
     /// Particle samples averaged (particles times steps).
     pub particles: usize,
@@ -153,59 +154,24 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
     let reading_tolerance = setup
         .reading_tolerance
         .unwrap_or(READING_TOLERANCE_PER_RADIUS * setup.particle_radius);
-    // The reading solves the force balance to τ alone: the density rule would end the
-    // iteration as soon as the compression is small, long before the forces balance.
-    world.set_density_tolerance(0.0)?;
-    world.set_displacement_tolerance(reading_tolerance)?;
-    let inner = |p: &Vec3| {
-        p.x - tank.min.x >= h_support
-            && tank.max.x - p.x >= h_support
-            && p.z - tank.min.z >= h_support
-            && tank.max.z - p.z >= h_support
-    };
-    // Layer sums (pressure, height, particles) over the reading window: one step's
-    // multipliers are noisy.
-    let layers = ((tank.max.y - tank.min.y) / d).ceil() as usize + 1;
-    let mut sums = vec![(0.0, 0.0, 0usize); layers];
-    let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
-    let mut estimates = Vec::new();
-    world.advance_with(READING_WINDOW, |w| {
-        let support;
-        let pressures = w.constraint_pressures();
-        (estimates, support) = (pressures.samples, pressures.mean_vertical_force);
-        for (p, v) in estimates.iter().filter(|(p, _)| inner(p)) {
-            let y = p.y - tank.min.y;
-            let i = ((y / d).max(0.0) as usize).min(layers - 1);
-            sums[i].0 += v;
-            sums[i].1 += y;
-            sums[i].2 += 1;
-        }
-        support_sum += support;
-        sampled_steps += 1;
-        progress(w.time() / end);
-        Ok(())
-    })?;
-    let rho0 = world.params().rest_density;
-    let g = Vec3::from(world.params().gravity).norm();
-    let floor = tank.min.y;
-
-    let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
-    let support = support_sum / sampled_steps.max(1) as f64;
     // The water's top face is the pressure datum: H above the floor plane is height + d/2.
     let datum = height + 0.5 * d;
-    let profile: Vec<Layer> = sums
-        .iter()
-        .filter(|s| s.2 > 0)
-        .map(|s| {
-            let y = s.1 / s.2 as f64;
-            Layer {
-                height: y,
-                pressure: s.0 / s.2 as f64,
-                hydrostatic: rho0 * g * (datum - y),
-                particles: s.2,
-            }
-        })
-        .collect();
+    let (rho0, g) = (
+        world.params().rest_density,
+        Vec3::from(world.params().gravity).norm(),
+    );
+    let (mut support_sum, mut sampled_steps) = (0.0, 0usize);
+    let mut estimates = Vec::new();
+    let hydrostatic = |y: f64| rho0 * g * (datum - y);
+    let profile = layer_profile(&mut world, &tank, reading_tolerance, hydrostatic, |w, p| {
+        estimates.clone_from(&p.samples);
+        support_sum += p.mean_vertical_force;
+        sampled_steps += 1;
+        progress(w.time() / end);
+    })?;
+    let floor = tank.min.y;
+    let pressures: Vec<(f64, f64)> = estimates.iter().map(|(p, v)| (p.y - floor, *v)).collect();
+    let support = support_sum / sampled_steps.max(1) as f64;
     let fitted: Vec<(f64, f64)> = profile
         .iter()
         .filter(|l| l.height >= h_support && l.height <= datum - h_support)
@@ -235,4 +201,59 @@ pub fn simulate(setup: &Setup, mut progress: impl FnMut(f64)) -> Result<Report, 
         hydrostatic_slope: rho0 * g,
         force_balance: support / (world.particle_mass() * g),
     })
+}
+
+/// Reads the constraint pressure (docs/method.md §10.1) of `world` over [`READING_WINDOW`] more
+/// seconds, each step solved to the displacement tolerance `tolerance` (m) alone, and averages
+/// it over horizontal layers one spacing thick of the particles at least one support radius
+/// from the side walls of `tank`, one step's multipliers being noisy; `hydrostatic` gives the
+/// pressure to compare with (Pa) at a height above the floor plane (m), and `each` sees every
+/// step's reading. The layers from the floor up.
+pub(crate) fn layer_profile(
+    world: &mut World,
+    tank: &Aabb,
+    tolerance: f64,
+    hydrostatic: impl Fn(f64) -> f64,
+    mut each: impl FnMut(&World, &ConstraintPressures),
+) -> Result<Vec<Layer>, Error> {
+    let d = world.params().spacing();
+    let h = world.params().support_radius();
+    // The reading solves the force balance to τ alone: the density rule would end the
+    // iteration as soon as the compression is small, long before the forces balance.
+    world.set_density_tolerance(0.0)?;
+    world.set_displacement_tolerance(tolerance)?;
+    let inner = |p: &Vec3| {
+        p.x - tank.min.x >= h
+            && tank.max.x - p.x >= h
+            && p.z - tank.min.z >= h
+            && tank.max.z - p.z >= h
+    };
+    // Layer sums: pressure, height, particles.
+    let layers = ((tank.max.y - tank.min.y) / d).ceil() as usize + 1;
+    let mut sums = vec![(0.0, 0.0, 0usize); layers];
+    world.advance_with(READING_WINDOW, |w| {
+        let pressures = w.constraint_pressures();
+        for (p, v) in pressures.samples.iter().filter(|(p, _)| inner(p)) {
+            let y = p.y - tank.min.y;
+            let i = ((y / d).max(0.0) as usize).min(layers - 1);
+            sums[i].0 += v;
+            sums[i].1 += y;
+            sums[i].2 += 1;
+        }
+        each(w, &pressures);
+        Ok(())
+    })?;
+    Ok(sums
+        .iter()
+        .filter(|s| s.2 > 0)
+        .map(|s| {
+            let y = s.1 / s.2 as f64;
+            Layer {
+                height: y,
+                pressure: s.0 / s.2 as f64,
+                hydrostatic: hydrostatic(y),
+                particles: s.2,
+            }
+        })
+        .collect())
 }

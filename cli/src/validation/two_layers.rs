@@ -5,9 +5,8 @@
 //!
 //! At rest: a tank n × 1.6n × n particles, the upper half of the lighter liquid, settles with
 //! the calm settings (damped relaxation, then a free run); the pressure is then read from the
-//! constraint forces (docs/method.md §10.1) with the tight solve of the hydrostatic
-//! validation ([`READING_TOLERANCE_PER_RADIUS`]) and averaged over layers one spacing thick,
-//! away from the side walls.
+//! constraint forces (docs/method.md §10.1) as the hydrostatic validation reads it
+//! ([`layer_profile`]), averaged over layers one spacing thick away from the side walls.
 //!
 //! Overturning: a tank 1.2n × 2n × 6 particles, water over the lighter liquid, the interface
 //! bent by one cosine across the tank of amplitude 0.2n spacings, runs at the defaults; the
@@ -18,7 +17,7 @@ mod report;
 pub use report::{ReportFiles, write_report};
 
 use super::fit::least_squares_slope;
-use super::hydrostatic::{READING_TOLERANCE_PER_RADIUS, READING_WINDOW};
+use super::hydrostatic::{Layer, READING_TOLERANCE_PER_RADIUS, layer_profile};
 use projfluid::boundary::Aabb;
 use projfluid::{Error, Material, MaterialId, Params, SolverKind, Vec3, World};
 
@@ -108,17 +107,6 @@ impl Setup {
             ..Params::with_radius(self.particle_radius)
         }
     }
-}
-
-/// One layer of the tank at rest, its samples averaged over the reading.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Layer {
-    /// Mean height of the layer's samples (m).
-    pub height: f64,
-    /// Mean pressure estimate (Pa).
-    pub pressure: f64,
-    /// The two-slope hydrostatic pressure at that height (Pa).
-    pub hydrostatic: f64,
 }
 
 /// The tank at rest.
@@ -259,20 +247,6 @@ fn at_rest(setup: &Setup) -> Result<Rest, Error> {
         inner.iter().sum::<f64>() / inner.len().max(1) as f64
     };
 
-    world.set_density_tolerance(0.0)?;
-    world.set_displacement_tolerance(READING_TOLERANCE_PER_RADIUS * r)?;
-    let mut sums = vec![(0.0, 0.0, 0usize); count[1] + 4];
-    let start = world.time();
-    while world.time() < start + READING_WINDOW {
-        world.step()?;
-        for (p, pressure) in world.constraint_pressures().samples {
-            let inner = [(p.x, tank.max.x), (p.z, tank.max.z)];
-            if inner.iter().all(|&(c, max)| c > h && c < max - h) {
-                let layer = &mut sums[((p.y / d) as usize).min(count[1] + 3)];
-                *layer = (layer.0 + p.y, layer.1 + pressure, layer.2 + 1);
-            }
-        }
-    }
     let surface = top + 0.5 * d;
     let (rho_w, rho_l) = (world.params().rest_density, setup.light_density);
     let hydrostatic = |y: f64| {
@@ -282,18 +256,8 @@ fn at_rest(setup: &Setup) -> Result<Rest, Error> {
             rho_l * g * (surface - interface) + rho_w * g * (interface - y)
         }
     };
-    let layers: Vec<Layer> = sums
-        .iter()
-        .filter(|l| l.2 > 0)
-        .map(|l| {
-            let height = l.0 / l.2 as f64;
-            Layer {
-                height,
-                pressure: l.1 / l.2 as f64,
-                hydrostatic: hydrostatic(height),
-            }
-        })
-        .collect();
+    let tolerance = READING_TOLERANCE_PER_RADIUS * r;
+    let layers = layer_profile(&mut world, &tank, tolerance, hydrostatic, |_, _| {})?;
     let within = |low: f64, high: f64| -> Vec<(f64, f64)> {
         layers
             .iter()

@@ -35,7 +35,7 @@ pub use point::PressureProbe;
 
 use crate::boundary::Aabb;
 use crate::neighbors::NeighborLists;
-use crate::{Error, World};
+use crate::{Error, Vec3, World};
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 
@@ -170,22 +170,13 @@ impl ProbeSet {
     /// any thread count. Errors: the checks of [`ProbeSet::validate_for`] with the world's
     /// gravity and containers. Panics when the memory for the reading cannot be had.
     pub fn read(&self, world: &World) -> Result<ProbeReading, Error> {
-        self.validate_for(world.params().gravity, world.containers())?;
-        let lines: Vec<gauge::Line> = self
-            .gauges
-            .iter()
-            .map(|g| g.line(world.containers()))
-            .collect::<Option<_>>()
-            .expect("validate_for found a bottom for every gauge");
+        let lines = self.lines(world)?;
         let (heights, pressures) = world.pool.install(|| {
             let Some(snapshot) = world.snapshot() else {
                 return (vec![0.0; lines.len()], vec![f64::NAN; self.pressure.len()]);
             };
             let mut lists = (NeighborLists::default(), NeighborLists::default());
-            let heights = lines
-                .iter()
-                .map(|line| line.reading(world, &snapshot, &mut lists))
-                .collect();
+            let heights = gauge::read_all(&lines, world, &snapshot, &mut lists);
             let pressures = if self.pressure.is_empty() {
                 Vec::new()
             } else {
@@ -199,6 +190,52 @@ impl ProbeSet {
             heights,
             pressures,
         })
+    }
+
+    /// Reads the set's gauges on the fluid positions `fluid` (m) in place of `world`'s own
+    /// fluid, with the world's boundary, containers and particle size: a frame written
+    /// earlier, or a frame of another solver on the same geometry. The reading carries `time`
+    /// (s). Pressure probes read NaN, since they need the constraint forces of the world's own
+    /// fluid. Deterministic for any thread count. Errors: the checks of
+    /// [`ProbeSet::validate_for`], and a position that is not finite (naming its index).
+    /// Panics when the memory for the reading cannot be had.
+    pub fn read_frame(
+        &self,
+        world: &World,
+        fluid: &[Vec3],
+        time: f64,
+    ) -> Result<ProbeReading, Error> {
+        let lines = self.lines(world)?;
+        if let Some(i) = fluid.iter().position(|p| !p.iter().all(|c| c.is_finite())) {
+            return Err(Error::invalid(
+                format!("fluid[{i}]"),
+                format!("{:?}", fluid[i].as_slice()),
+                "must be a finite position",
+            ));
+        }
+        let heights = world.pool.install(|| {
+            let Some(snapshot) = world.snapshot_of(fluid, 0.0, false) else {
+                return vec![0.0; lines.len()];
+            };
+            let mut lists = (NeighborLists::default(), NeighborLists::default());
+            gauge::read_all(&lines, world, &snapshot, &mut lists)
+        });
+        Ok(ProbeReading {
+            time,
+            heights,
+            pressures: vec![f64::NAN; self.pressure.len()],
+        })
+    }
+
+    /// Every gauge's line in `world`, after the checks of [`ProbeSet::validate_for`].
+    fn lines(&self, world: &World) -> Result<Vec<gauge::Line>, Error> {
+        self.validate_for(world.params().gravity, world.containers())?;
+        Ok(self
+            .gauges
+            .iter()
+            .map(|g| g.line(world.containers()))
+            .collect::<Option<_>>()
+            .expect("validate_for found a bottom for every gauge"))
     }
 }
 

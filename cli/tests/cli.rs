@@ -1384,6 +1384,84 @@ fn bad_probes_exit_2() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
+/// `projfluid probes` reads a scene's gauges on saved frames: on the frames of a run (legacy
+/// VTK, binary and ASCII) it reads what the run read at the same times, within the rounding of
+/// the frames' single-precision positions; frames without a time of their own need `--fps`,
+/// which numbers them k/fps; bad input exits 2 naming it.
+#[test]
+fn probes_read_on_saved_frames() {
+    let dir = temp_dir("probes-frames");
+    let scene = dir.join("tank.json");
+    std::fs::write(&scene, PROBE_TANK).unwrap();
+    let scene = scene.to_str().unwrap();
+    for format in ["vtk", "vtk-ascii"] {
+        let out = dir.join(format);
+        let args = ["run", scene, "--fps", "50", "--format", format, "--out"];
+        let run = projfluid(&[&args[..], &[out.to_str().unwrap()]].concat());
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let csv = dir.join(format!("{format}.csv"));
+        let (frames, csv_str) = (out.to_str().unwrap(), csv.to_str().unwrap());
+        let read = projfluid(&["probes", scene, "--frames", frames, "--out", csv_str]);
+        assert!(
+            read.status.success(),
+            "{}",
+            String::from_utf8_lossy(&read.stderr)
+        );
+        let (header, rows) = read_csv(&csv);
+        let (run_header, run_rows) = read_csv(&out.join("probes.csv"));
+        assert_eq!(header, run_header);
+        assert_eq!(rows.len(), run_rows.len());
+        assert_eq!(rows.len(), 3, "{rows:?}");
+        for (row, run_row) in rows.iter().zip(&run_rows) {
+            let time = number(&header, row, "time_s");
+            assert!((time - number(&header, run_row, "time_s")).abs() < 1e-12);
+            let (h, run_h) = (number(&header, row, "S_m"), number(&header, run_row, "S_m"));
+            assert!(
+                (0.1..0.3).contains(&h) && (h - run_h).abs() < 1e-5,
+                "{h} {run_h}"
+            );
+        }
+    }
+    // The same frames without their time: refused without --fps; numbered by it.
+    let plain = dir.join("plain");
+    std::fs::create_dir_all(&plain).unwrap();
+    for k in 0..3 {
+        let text = std::fs::read(dir.join(format!("vtk-ascii/frame_{k:05}.vtk"))).unwrap();
+        let text = String::from_utf8(text).unwrap();
+        let start = text.find("FIELD").unwrap();
+        let end = text.find("POINTS").unwrap();
+        let untimed = format!("{}{}", &text[..start], &text[end..]);
+        std::fs::write(plain.join(format!("other_{}.vtk", k + 1)), untimed).unwrap();
+    }
+    let (plain, csv) = (plain.to_str().unwrap(), dir.join("plain.csv"));
+    let out = projfluid(&["probes", scene, "--frames", plain]);
+    assert_bad_input(&out, &["other_1.vtk", "--fps"]);
+    let csv_str = csv.to_str().unwrap();
+    let read = projfluid(&[
+        "probes", scene, "--frames", plain, "--fps", "4", "--out", csv_str,
+    ]);
+    assert!(
+        read.status.success(),
+        "{}",
+        String::from_utf8_lossy(&read.stderr)
+    );
+    let (header, rows) = read_csv(&csv);
+    let times: Vec<f64> = rows.iter().map(|r| number(&header, r, "time_s")).collect();
+    assert_eq!(times, [0.0, 0.25, 0.5]);
+    let missing = dir.join("none");
+    let out = projfluid(&["probes", scene, "--frames", missing.to_str().unwrap()]);
+    assert_bad_input(&out, &["cannot read directory", "none"]);
+    let out = projfluid(&["probes", scene, "--frames", plain, "--fps", "0"]);
+    assert_bad_input(&out, &["--fps", "positive"]);
+    let out = projfluid(&["probes", "dam_break_small", "--frames", plain]);
+    assert_bad_input(&out, &["dam_break_small", "no probes"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
 /// A fluid block overlapping a static body: the run's first line says how many particles the
 /// scene's blocks held inside the solid and were not created.
 #[test]

@@ -6,7 +6,7 @@ mod support;
 
 use projfluid::scene::Scene;
 use projfluid_lab::validation::kleefsman::{
-    self, Comparison, LEE_GAUGE, Measurements, Run, Setup, Tolerances, Verdict,
+    self, Comparison, LEE_GAUGE, Measurements, Reference, Run, Setup, Tolerances, Verdict,
 };
 use std::path::{Path, PathBuf};
 use support::{projfluid, projfluid_ok};
@@ -26,7 +26,8 @@ fn dam_break(duration: f64, change: impl FnOnce(&mut Setup)) -> (Run, Comparison
     change(&mut setup);
     let run = kleefsman::simulate(&setup, |_| {}).expect("dam break runs");
     let data = Measurements::load().unwrap();
-    let cmp = kleefsman::compare(&run, &data, Tolerances::default());
+    let reference = Reference::load().unwrap();
+    let cmp = kleefsman::compare(&run, &data, &reference, Tolerances::default());
     (run, cmp)
 }
 
@@ -172,10 +173,13 @@ fn cli_kleefsman_writes_its_table_csv_and_charts() {
     );
     let csv = std::fs::read_to_string(dir.join("kleefsman_comparison.csv")).unwrap();
     assert!(csv.lines().any(|l| l.starts_with("arrival_s,H1,")), "{csv}");
-    assert!(
-        csv.lines().any(|l| l.starts_with("content_rms_m,H1,")),
-        "{csv}"
-    );
+    for kind in ["content_rms_m", "reference_rms_m", "reference_arrival_s"] {
+        assert!(
+            csv.lines().any(|l| l.starts_with(&format!("{kind},H1,"))),
+            "{csv}"
+        );
+    }
+    assert!(stdout.contains("reference"), "{stdout}");
     assert!(stdout.contains("water on H1's line"), "{stdout}");
 }
 

@@ -153,6 +153,20 @@ pub(super) struct Line {
     measure: GaugeMeasure,
 }
 
+/// The readings (m) of `lines` in `snapshot` of `world`, in their order; `lists` are scratch
+/// for the neighbour searches.
+pub(super) fn read_all(
+    lines: &[Line],
+    world: &World,
+    snapshot: &Snapshot,
+    lists: &mut (NeighborLists, NeighborLists),
+) -> Vec<f64> {
+    lines
+        .iter()
+        .map(|line| line.reading(world, snapshot, lists))
+        .collect()
+}
+
 impl Line {
     /// The gauge's reading (m) in `snapshot` of `world`, by its [`GaugeMeasure`]. `lists` are
     /// scratch for the neighbour searches (fluid, boundary). Runs on the caller's thread pool.

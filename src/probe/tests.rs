@@ -384,6 +384,68 @@ fn readings_do_not_depend_on_the_thread_count() {
     assert!(one.pressures[1] > 0.0, "{one:?}");
 }
 
+/// Gauges read on a frame of positions: the world's own positions read what the world reads,
+/// to the bit; the water without its top layer reads a spacing lower; a frame with no water on a line
+/// reads a dry floor; pressure probes read NaN; a position that is not finite is refused,
+/// naming it.
+#[test]
+fn gauges_read_frames_of_positions() {
+    let mut world = small_tank(1);
+    for _ in 0..6 {
+        world.step().unwrap();
+    }
+    let probes = ProbeSet {
+        rate: 100.0,
+        gauges: vec![
+            Gauge::new("H1", 0.175, 0.175),
+            Gauge {
+                measure: GaugeMeasure::Content,
+                ..Gauge::new("C1", 0.175, 0.175)
+            },
+        ],
+        pressure: vec![PressureProbe::new("P1", [0.175, 0.05, 0.175])],
+    };
+    let own = probes.read(&world).unwrap();
+    let positions = world.positions();
+    let frame = probes.read_frame(&world, &positions, 0.5).unwrap();
+    assert_eq!(frame.time, 0.5);
+    let bits = |h: &[f64]| h.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&frame.heights), bits(&own.heights));
+    assert!(frame.pressures[0].is_nan() && own.pressures[0].is_finite());
+    // Without its top layer the water's surface reads a spacing lower, within a quarter of
+    // one, and the content a layer less.
+    let d = world.params().spacing();
+    let top = positions.iter().map(|p| p.y).fold(f64::MIN, f64::max);
+    let lower: Vec<Vec3> = positions
+        .iter()
+        .filter(|p| p.y < top - 0.5 * d)
+        .copied()
+        .collect();
+    let layer = probes.read_frame(&world, &lower, 0.5).unwrap();
+    let drop = own.heights[0] - layer.heights[0];
+    assert!((drop - d).abs() < 0.25 * d, "{layer:?} {own:?}");
+    let drop = own.heights[1] - layer.heights[1];
+    assert!((drop - d).abs() < 0.25 * d, "{layer:?} {own:?}");
+    // Moved off the line, the water leaves a dry floor there.
+    let aside: Vec<Vec3> = positions
+        .iter()
+        .filter(|p| (p.x - 0.175).abs() > 0.1 || (p.z - 0.175).abs() > 0.1)
+        .copied()
+        .collect();
+    let dry = probes.read_frame(&world, &aside, 0.5).unwrap();
+    assert!(
+        dry.heights[0] < d && dry.heights[1] < 0.05 * own.heights[1],
+        "{dry:?}"
+    );
+    let mut bad = positions.clone();
+    bad[3].y = f64::NAN;
+    let e = probes
+        .read_frame(&world, &bad, 0.5)
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("fluid[3]") && e.contains("finite"), "{e}");
+}
+
 /// Bad definitions are rejected with the key and the value.
 #[test]
 fn bad_probe_definitions_name_the_key() {

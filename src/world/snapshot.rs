@@ -77,8 +77,18 @@ impl World {
     /// their current poses join the boundary with their own masses (before the first step
     /// the boundary does not hold them yet).
     pub(crate) fn snapshot_with(&self, margin: f64, bodies: bool) -> Option<Snapshot> {
+        self.snapshot_of(&self.fluid.positions, margin, bodies)
+    }
+
+    /// [`World::snapshot_with`] of the fluid positions `fluid` (m) in place of the world's
+    /// own, with the world's boundary. `fluid_order` then indexes `fluid`.
+    pub(crate) fn snapshot_of(
+        &self,
+        fluid: &[Vec3],
+        margin: f64,
+        bodies: bool,
+    ) -> Option<Snapshot> {
         let h = self.params.support_radius();
-        let fluid = &self.fluid.positions;
         let boundary = &self.boundary;
         let (mut points, known) = if bodies && boundary.has_moving() {
             let (statics, _) = boundary.statics();

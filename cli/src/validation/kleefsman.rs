@@ -18,19 +18,22 @@
 //! starts compressed in a corner (docs/method.md §7), and the fluid lattice fills the
 //! reservoir from its faces ([`Setup::scene`]).
 //!
-//! Submodules hold the setup ([`Setup`]), the measurements ([`Measurements`]), the comparison
-//! ([`compare`]) and the report ([`write_report`]); the run itself is [`simulate`].
+//! Submodules hold the setup ([`Setup`]), the measurements ([`Measurements`]), the reference
+//! solver's run of the same geometry ([`Reference`]), the comparison ([`compare`]) and the
+//! report ([`write_report`]); the run itself is [`simulate`].
 
 mod compare;
 mod measured;
+mod reference;
 mod report;
 mod setup;
 
 pub use compare::{
     ARRIVAL_GAUGES, ARRIVAL_LEVEL, Arrival, Comparison, LEE_GAUGE, RESERVOIR_GAUGE,
-    RESERVOIR_TIMES, ReservoirLevel, Tolerances, Verdict, compare,
+    RESERVOIR_TIMES, ReferenceComparison, ReservoirLevel, Tolerances, Verdict, compare,
 };
 pub use measured::{DATA_FILE, Measurements, SOURCE_COLUMNS};
+pub use reference::{REFERENCE_FILE, REFERENCE_LABEL, Reference};
 pub use report::{ReportFiles, write_report};
 pub use setup::{PROBE_RATE, SCENE_NAME, Setup};
 

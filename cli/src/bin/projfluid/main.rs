@@ -16,6 +16,7 @@
 //!                 [--threads N] [--out DIR]
 //! projfluid tune-rho SCENE [--steps T] [--warmup N] [--from R] [--to R] [--step R]
 //!                    [--tau METRES] [--threads N] [--out DIR]
+//! projfluid probes SCENE --frames DIR [--fps N] [--out FILE] [--threads N]
 //! ```
 //!
 //! Exit codes: 0 success, 1 runtime failure (e.g. output not writable), 2 bad input.
@@ -24,6 +25,7 @@
 mod bench;
 mod frames;
 mod probes;
+mod read_probes;
 mod run;
 mod tune_rho;
 mod validate;
@@ -61,6 +63,9 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Choose Chebyshev's ρ for a scene: estimate it, then sweep it.
     TuneRho(tune_rho::TuneRhoArgs),
+    /// Read a scene's probes on frames written earlier (legacy VTK, by projfluid or another
+    /// solver on the same geometry) and write their readings as CSV.
+    Probes(read_probes::ProbesArgs),
 }
 
 /// Why the program stops early; decides the exit code.
@@ -124,6 +129,7 @@ fn main() -> ExitCode {
         Command::Validate(command) => validate::validate(&command),
         Command::Bench(args) => bench::bench(&args),
         Command::TuneRho(args) => tune_rho::tune_rho(&args),
+        Command::Probes(args) => read_probes::read_probes(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

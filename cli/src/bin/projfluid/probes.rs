@@ -5,7 +5,7 @@
 
 use crate::Failure;
 use projfluid::World;
-use projfluid::probe::ProbeSet;
+use projfluid::probe::{ProbeReading, ProbeSet};
 use projfluid_lab::driver::frame_index;
 use std::fs::File;
 use std::io::Write;
@@ -107,13 +107,8 @@ impl ProbeLog {
             .probes
             .read(world)
             .map_err(|e| Failure::Input(e.to_string()))?;
-        let mut row = reading.time.to_string();
-        for value in reading.values() {
-            row += &format!(",{value}");
-        }
-        row.push('\n');
         self.file
-            .write_all(row.as_bytes())
+            .write_all(row(&reading).as_bytes())
             .map_err(|e| Failure::Runtime(format!("cannot write {}: {e}", self.path.display())))?;
         Ok(())
     }
@@ -131,10 +126,19 @@ fn in_dir(dir: &Path) -> Result<PathBuf, Failure> {
 }
 
 /// The header line: `time_s`, then every probe's column with its unit.
-fn header(probes: &ProbeSet) -> String {
+pub(crate) fn header(probes: &ProbeSet) -> String {
     let mut header = String::from("time_s");
     for column in probes.columns() {
         header += &format!(",{column}");
     }
     header + "\n"
+}
+
+/// One reading's line: its time, then every value, each printed so that it reads back exactly.
+pub(crate) fn row(reading: &ProbeReading) -> String {
+    let mut row = reading.time.to_string();
+    for value in reading.values() {
+        row += &format!(",{value}");
+    }
+    row + "\n"
 }

@@ -342,6 +342,7 @@ fn kleefsman(args: &KleefsmanArgs) -> Result<(), Failure> {
     };
     setup.validate().map_err(option_error)?;
     let data = kleefsman::Measurements::load().map_err(runtime)?;
+    let reference = kleefsman::Reference::load().map_err(runtime)?;
     create_dir(&args.common.out)?;
     let [nx, ny, nz] = setup.fluid_count();
     eprintln!(
@@ -360,8 +361,10 @@ fn kleefsman(args: &KleefsmanArgs) -> Result<(), Failure> {
     );
     let clock = Instant::now();
     let run = kleefsman::simulate(&setup, |_| {}).map_err(runtime)?;
-    let cmp = kleefsman::compare(&run, &data, kleefsman::Tolerances::default());
-    let files = kleefsman::write_report(&args.common.out, &run, &data, &cmp).map_err(runtime)?;
+    let tolerances = kleefsman::Tolerances::default();
+    let cmp = kleefsman::compare(&run, &data, &reference, tolerances);
+    let files = kleefsman::write_report(&args.common.out, &run, &data, &reference, &cmp)
+        .map_err(runtime)?;
     let mut text = format!(
         "{} fluid particles, {} boundary particles, {} steps ({:.2} outer iterations per step) \
          in {:.1} s; max compression {:.3} %, {} escaped\n\n",

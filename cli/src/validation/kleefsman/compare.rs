@@ -1,8 +1,9 @@
 //! Simulation against measurement: the surge's arrival at the gauges H3, H2 and H1, the
 //! reservoir's fall at H4, and the RMS difference of every gauge's height; and, reported
-//! beside them, the water content's arrival at H1 and its RMS difference at every gauge.
+//! beside them, the water content's arrival at H1 and its RMS difference at every gauge, and the
+//! reference solver's arrivals and RMS differences over the same times.
 
-use super::{GAUGES, Measurements, Run};
+use super::{GAUGES, Measurements, Reference, Run};
 use crate::validation::{first_crossing, interpolate};
 
 /// Water height (m) whose first crossing marks the surge's arrival at a gauge: ten times the
@@ -141,12 +142,31 @@ pub struct Comparison {
     pub lee_content: Arrival,
     /// As `rms`, for the water content of each gauge's line against the measured height.
     pub content_rms: [f64; 4],
+    /// The reference solver against the same measurements (reported, not judged).
+    pub reference: ReferenceComparison,
     /// The tolerances the verdicts use.
     pub tolerances: Tolerances,
 }
 
-/// Compares `run` with `data` under `tolerances`.
-pub fn compare(run: &Run, data: &Measurements, tolerances: Tolerances) -> Comparison {
+/// The reference solver's run ([`Reference`]) against the measurements, over the times the
+/// compared run covers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReferenceComparison {
+    /// The reference's first crossing of [`ARRIVAL_LEVEL`] (s) at each gauge of
+    /// [`ARRIVAL_GAUGES`], in that order; `None` if it never reached it within the run's time.
+    pub arrivals: Vec<Option<f64>>,
+    /// RMS of reference − measured height (m) at each gauge of [`GAUGES`], over the measured
+    /// times that both the run and the reference cover.
+    pub rms: [f64; 4],
+}
+
+/// Compares `run`, and `reference` over the same times, with `data` under `tolerances`.
+pub fn compare(
+    run: &Run,
+    data: &Measurements,
+    reference: &Reference,
+    tolerances: Tolerances,
+) -> Comparison {
     let end = run.end();
     // The arrival at gauge g of the simulated series `sim` (surface or content).
     let arrival = |g: usize, sim: Vec<(f64, f64)>| Arrival {
@@ -173,6 +193,7 @@ pub fn compare(run: &Run, data: &Measurements, tolerances: Tolerances) -> Compar
     let rms_against = |g: usize, sim: Vec<(f64, f64)>| {
         let squares: Vec<f64> = data.heights[g]
             .iter()
+            .filter(|&&(t, _)| t <= end)
             .filter_map(|&(t, h)| interpolate(&sim, t).map(|s| (s - h).powi(2)))
             .collect();
         (squares.iter().sum::<f64>() / squares.len().max(1) as f64).sqrt()
@@ -183,6 +204,15 @@ pub fn compare(run: &Run, data: &Measurements, tolerances: Tolerances) -> Compar
         rms: std::array::from_fn(|g| rms_against(g, run.heights(g))),
         lee_content: arrival(LEE_GAUGE, run.contents(LEE_GAUGE)),
         content_rms: std::array::from_fn(|g| rms_against(g, run.contents(g))),
+        reference: ReferenceComparison {
+            arrivals: ARRIVAL_GAUGES
+                .iter()
+                .map(|&g| {
+                    first_crossing(&reference.heights[g], ARRIVAL_LEVEL).filter(|&t| t <= end)
+                })
+                .collect(),
+            rms: std::array::from_fn(|g| rms_against(g, reference.heights[g].clone())),
+        },
         tolerances,
     }
 }

@@ -33,35 +33,51 @@ impl Measurements {
 
 /// Parses `text` in the layout of [`DATA_FILE`].
 fn parse(text: &str) -> Result<Measurements, Error> {
+    let series = parse_columns(DATA_FILE, text, "Time_s", &SOURCE_COLUMNS)?;
+    let heights = series.try_into().expect("one series per gauge");
+    debug_assert_eq!(GAUGES.len(), 4);
+    Ok(Measurements { heights })
+}
+
+/// The (time, value) series of each of `columns` in the CSV `text` of the data file `file`:
+/// `#` comment lines, a header naming the columns (`time` among them), then comma-separated
+/// rows of numbers. Errors name the file, and the line and column of a cell that is not a
+/// number, or the column the header lacks.
+pub(super) fn parse_columns(
+    file: &str,
+    text: &str,
+    time: &str,
+    columns: &[&str],
+) -> Result<Vec<Vec<(f64, f64)>>, Error> {
     let mut rows = text
         .lines()
         .enumerate()
         .filter(|(_, l)| !l.trim_start().starts_with('#') && !l.trim().is_empty());
     let (_, header) = rows
         .next()
-        .ok_or_else(|| Error::invalid(DATA_FILE, "no rows", "must hold a header and data"))?;
+        .ok_or_else(|| Error::invalid(file, "no rows", "must hold a header and data"))?;
     let names: Vec<&str> = header.split(',').map(str::trim).collect();
     let column = |name: &str| {
         names.iter().position(|n| *n == name).ok_or_else(|| {
             Error::invalid(
-                DATA_FILE,
+                file,
                 format!("header `{header}`"),
                 &format!("must have a column `{name}`"),
             )
         })
     };
-    let time = column("Time_s")?;
-    let columns = SOURCE_COLUMNS
+    let time = column(time)?;
+    let columns = columns
         .iter()
         .map(|name| column(name))
         .collect::<Result<Vec<usize>, Error>>()?;
-    let mut heights: [Vec<(f64, f64)>; 4] = Default::default();
+    let mut series = vec![Vec::new(); columns.len()];
     for (i, line) in rows {
         let cells: Vec<&str> = line.split(',').collect();
         let value = |c: usize| -> Result<f64, Error> {
             let bad = || {
                 Error::invalid(
-                    format!("{DATA_FILE} line {} column {}", i + 1, c + 1),
+                    format!("{file} line {} column {}", i + 1, c + 1),
                     line,
                     "must be a number",
                 )
@@ -74,12 +90,11 @@ fn parse(text: &str) -> Result<Measurements, Error> {
                 .map_err(|_| bad())
         };
         let t = value(time)?;
-        for (series, &c) in heights.iter_mut().zip(&columns) {
-            series.push((t, value(c)?));
+        for (points, &c) in series.iter_mut().zip(&columns) {
+            points.push((t, value(c)?));
         }
     }
-    debug_assert_eq!(GAUGES.len(), heights.len());
-    Ok(Measurements { heights })
+    Ok(series)
 }
 
 #[cfg(test)]

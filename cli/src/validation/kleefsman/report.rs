@@ -2,7 +2,7 @@
 //! CSV, and one chart per gauge as PNG.
 
 use super::compare::Verdict;
-use super::{Comparison, GAUGE_X, GAUGES, Measurements, Run};
+use super::{Comparison, GAUGE_X, GAUGES, Measurements, REFERENCE_LABEL, Reference, Run};
 use crate::plot::{LineChart, Series, SeriesStyle};
 use crate::validation::write_text;
 use projfluid::Error;
@@ -31,15 +31,16 @@ impl Comparison {
         );
         let _ = writeln!(
             out,
-            "{:>5}  {:>7}  {:>9}  {:>9}  {:>8}",
-            "gauge", "x (m)", "sim (s)", "meas (s)", "delay"
+            "{:>5}  {:>7}  {:>9}  {:>9}  {:>8}  {:>7}  {:>9}",
+            "gauge", "x (m)", "sim (s)", "meas (s)", "delay", "", "ref (s)"
         );
-        for a in &self.arrivals {
+        for (a, reference) in self.arrivals.iter().zip(&self.reference.arrivals) {
             let sim = a.simulated.map_or("-".into(), |s| format!("{s:.3}"));
             let delay = a.delay().map_or("-".into(), |d| format!("{d:+.3}"));
+            let reference = reference.map_or("-".into(), |s| format!("{s:.3}"));
             let _ = writeln!(
                 out,
-                "{:>5}  {:>7.3}  {sim:>9}  {:>9.3}  {delay:>8}  {}",
+                "{:>5}  {:>7.3}  {sim:>9}  {:>9.3}  {delay:>8}  {:>7}  {reference:>9}",
                 GAUGES[a.gauge],
                 GAUGE_X[a.gauge],
                 a.measured,
@@ -72,17 +73,23 @@ impl Comparison {
         let _ = writeln!(
             out,
             "\nRMS difference from the measured height over the run (m): the standing water's \
-             surface, and the water content of the line (all the water on it)"
+             surface, the water content of the line (all the water on it), and the surface in \
+             the reference run ({REFERENCE_LABEL}) over the same times"
         );
         let _ = writeln!(
             out,
-            "{:>5}  {:>7}  {:>8}  {:>8}",
-            "gauge", "x (m)", "surface", "content"
+            "{:>5}  {:>7}  {:>8}  {:>8}  {:>9}",
+            "gauge", "x (m)", "surface", "content", "reference"
         );
-        for (g, (rms, content)) in self.rms.iter().zip(&self.content_rms).enumerate() {
+        let rows = self
+            .rms
+            .iter()
+            .zip(&self.content_rms)
+            .zip(&self.reference.rms);
+        for (g, ((rms, content), reference)) in rows.enumerate() {
             let _ = writeln!(
                 out,
-                "{:>5}  {:>7.3}  {rms:>8.4}  {content:>8.4}",
+                "{:>5}  {:>7.3}  {rms:>8.4}  {content:>8.4}  {reference:>9.4}",
                 GAUGES[g], GAUGE_X[g]
             );
         }
@@ -100,7 +107,8 @@ impl Comparison {
     }
 
     /// CSV of every compared quantity: kind, gauge, time or level, measured, simulated
-    /// (empty when not reached), verdict.
+    /// (empty when not reached), verdict; the reference solver's rows hold its value as
+    /// simulated.
     pub fn csv(&self) -> String {
         let t = self.tolerances;
         let mut out = String::from("quantity,gauge,measured,simulated,verdict\n");
@@ -130,6 +138,17 @@ impl Comparison {
         for (g, rms) in self.content_rms.iter().enumerate() {
             let _ = writeln!(out, "content_rms_m,{},0,{rms},", GAUGES[g]);
         }
+        for (a, reference) in self.arrivals.iter().zip(&self.reference.arrivals) {
+            let reference = reference.map_or(String::new(), |s| format!("{s}"));
+            let _ = writeln!(
+                out,
+                "reference_arrival_s,{},{},{reference},",
+                GAUGES[a.gauge], a.measured
+            );
+        }
+        for (g, rms) in self.reference.rms.iter().enumerate() {
+            let _ = writeln!(out, "reference_rms_m,{},0,{rms},", GAUGES[g]);
+        }
         let a = &self.lee_content;
         let sim = a.simulated.map_or(String::new(), |s| format!("{s}"));
         let _ = writeln!(out, "content_arrival_s,H1,{},{sim},", a.measured);
@@ -149,11 +168,13 @@ pub struct ReportFiles {
 }
 
 /// Writes the gauge history and the comparison as CSV and a chart per gauge as PNG into
-/// `dir` (which must exist), named `kleefsman_*`.
+/// `dir` (which must exist), named `kleefsman_*`; the charts show the run, the measurements
+/// and the reference solver's run up to the run's end.
 pub fn write_report(
     dir: &Path,
     run: &Run,
     data: &Measurements,
+    reference: &Reference,
     cmp: &Comparison,
 ) -> Result<ReportFiles, Error> {
     let files = ReportFiles {
@@ -180,12 +201,11 @@ pub fn write_report(
     } else {
         ", no box".to_string()
     };
+    let until_end = |points: &[(f64, f64)]| -> Vec<(f64, f64)> {
+        points.iter().copied().filter(|p| p.0 <= end).collect()
+    };
     for (g, path) in files.charts.iter().enumerate() {
-        let measured: Vec<(f64, f64)> = data.heights[g]
-            .iter()
-            .copied()
-            .filter(|p| p.0 <= end)
-            .collect();
+        let measured = until_end(&data.heights[g]);
         let mut chart_series = vec![Series {
             label: format!("simulation, r = {} m{what}", run.setup.particle_radius),
             points: run.heights(g),
@@ -199,6 +219,11 @@ pub fn write_report(
                 style: SeriesStyle::Line,
             });
         }
+        chart_series.push(Series {
+            label: format!("reference solver, {REFERENCE_LABEL}"),
+            points: until_end(&reference.heights[g]),
+            style: SeriesStyle::Line,
+        });
         if !measured.is_empty() {
             chart_series.push(Series {
                 label: "measured (Kleefsman et al. 2005)".into(),

@@ -350,9 +350,9 @@ typedef struct PfParams {
      * `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
      * a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
      * no world, where it cannot be had; `pf_params_validate` checks only the value. A world
-     * on the GPU refuses bodies, emitters, walls built as fields, further materials and
-     * solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only
-     * with `kinematic_viscosity` and `vorticity_confinement` 0. Default `PF_BACKEND_CPU`.
+     * on the GPU refuses bodies, emitters, walls built as fields and solvers other than
+     * `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only with
+     * `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
      */
     uint32_t backend;
     /**
@@ -863,9 +863,9 @@ enum PfStatus pf_world_emitted_count(const struct PfWorld *world, uint64_t *out)
  *
  * Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
  * rest density that is not finite or lies outside 0.1 to 10 times the world's rest
- * density, the message giving the range in kg/m³; a world holding 256 materials already;
- * a world on the GPU backend, which steps one material only). On any error no material is
- * added and `*out` is untouched. Thread safety: one thread at a time per world.
+ * density, the message giving the range in kg/m³; a world holding 256 materials already).
+ * On any error no material is added and `*out` is untouched. Thread safety: one thread at a
+ * time per world.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.

@@ -20,9 +20,14 @@ const CELL_SLACK: f64 = 1.0 + 1e-4;
 /// The neighbour lists are grown to this multiple of what a step needs.
 const LIST_GROWTH: f64 = 1.25;
 
+/// Entries of the material table in [`StepParams`] (`inverse_ratio` in shaders/common.wgsl):
+/// one for every material a world can hold.
+pub(super) const MATERIAL_SLOTS: usize = 256;
+const _: () = assert!(crate::material::MAX_MATERIALS <= MATERIAL_SLOTS);
+
 /// The step's constants as the shaders read them (`StepParams` in shaders/common.wgsl).
 #[repr(C)]
-#[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub(super) struct StepParams {
     pub n: u32,
     pub boundary_n: u32,
@@ -41,11 +46,16 @@ pub(super) struct StepParams {
     pub rest_density: f32,
     pub dt2k: f32,
     pub membership_floor: f32,
-    /// XSPH c_X, the rest stencil size c, the Newton step limit H/4 (m).
+    /// XSPH c_X, the rest stencil size c, the Newton step limit H/4 (m), the vorticity
+    /// confinement's ε (dimensionless, 0 = off; docs/method.md §15).
     pub viscosity: f32,
     pub rest_stencil: f32,
     pub newton_limit: f32,
-    pub pad: f32,
+    pub vorticity: f32,
+    /// m/m_k = ρ0/ρ0_k of every material k (dimensionless; 0 past the world's materials),
+    /// four to an entry: what divides a particle's projection weight by its mass ratio
+    /// (docs/method.md §14).
+    pub inverse_ratio: [[f32; 4]; MATERIAL_SLOTS / 4],
 }
 
 /// One outer iteration's constants (`IterParams` in shaders/sweep.wgsl, finish.wgsl).
@@ -131,16 +141,19 @@ pub(super) struct Buffers {
     /// Fluid particles.
     pub n: u32,
     pub cells: u32,
-    /// x^n (m, relative), v (m/s), s (m) and each slot's particle (its index at upload).
+    /// x^n (m, relative), v (m/s), s (m), each slot's particle (its index at upload) and
+    /// its material (an index into [`StepParams::inverse_ratio`]).
     pub x: wgpu::Buffer,
     pub v: wgpu::Buffer,
     pub s: wgpu::Buffer,
     pub ids: wgpu::Buffer,
+    pub material: wgpu::Buffer,
     /// The permutation's targets, then the XSPH filter's velocities.
     pub x_out: wgpu::Buffer,
     pub v_out: wgpu::Buffer,
     pub s_out: wgpu::Buffer,
     pub ids_out: wgpu::Buffer,
+    pub material_out: wgpu::Buffer,
     /// The sort: each particle's cell, per cell its count and fill cursor, the order and
     /// each cell's first slot (cells + 1).
     pub cell_of: wgpu::Buffer,
@@ -171,23 +184,28 @@ pub(super) struct Buffers {
     pub flags: wgpu::Buffer,
     /// Per particle values to reduce (reduce.wgsl).
     pub values: wgpu::Buffer,
+    /// Every particle's vorticity ω_i (1/s) and |ω_i| in w, where the vorticity confinement
+    /// is on (shaders/vorticity.wgsl; 16 bytes otherwise).
+    pub vorticity: wgpu::Buffer,
     pub params: wgpu::Buffer,
     pub iter: wgpu::Buffer,
 }
 
-/// Bytes of a vec4<f32> and of a u32.
+/// Bytes of a `vec4<f32>` and of a `u32`.
 const VEC4: u64 = 16;
 const WORD: u64 = 4;
 
 impl Buffers {
     /// The buffers for `n` fluid particles and the sorted boundary `boundary` (device
-    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells.
+    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells;
+    /// with room for the vorticities where `vorticity` (the confinement is on).
     pub fn new(
         ctx: &Context,
         n: u32,
         cells: u32,
         boundary: &[[f32; 4]],
         boundary_start: &[u32],
+        vorticity: bool,
     ) -> Self {
         let particles = u64::from(n);
         let vec4 = |label| ctx.storage(label, particles * VEC4);
@@ -202,10 +220,12 @@ impl Buffers {
             v: vec4("v"),
             s: vec4("s"),
             ids: word("ids", particles),
+            material: word("material", particles),
             x_out: vec4("x_out"),
             v_out: vec4("v_out"),
             s_out: vec4("s_out"),
             ids_out: word("ids_out", particles),
+            material_out: word("material_out", particles),
             cell_of: word("cell_of", particles),
             counts: word("counts", cell_words),
             cursor: word("cursor", cell_words),
@@ -227,7 +247,8 @@ impl Buffers {
             density: word("density", particles),
             flags: word("flags", particles),
             values: vec4("values"),
-            params: ctx.uniform("params", &StepParams::default()),
+            vorticity: ctx.storage("vorticity", if vorticity { particles * VEC4 } else { 0 }),
+            params: ctx.uniform("params", &StepParams::zeroed()),
             iter: ctx.uniform("iter", &IterParams::default()),
         };
         ctx.queue

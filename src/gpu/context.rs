@@ -13,7 +13,7 @@ pub(super) const WORKGROUP: u32 = 256;
 /// The most workgroups a dispatch has along one axis (WebGPU's limit); larger dispatches
 /// are laid out over x and y (`item` in shaders/common.wgsl).
 const MAX_GROUPS: u32 = 65_535;
-/// Storage buffers the largest kernel binds (finish.wgsl, project.wgsl).
+/// Storage buffers the largest kernel binds (project.wgsl).
 const STORAGE_BUFFERS: u32 = 12;
 
 /// The device and queue, with the first error the device reported since the last check.

@@ -1,20 +1,30 @@
 //! The end of a step on the device (docs/method.md §1.3 steps 5–8; shaders/finish.wgsl):
-//! velocities from the positions, the new positions, the densities at them, the XSPH
-//! filter, and the per-particle values of the step's density errors and of the CFL rule,
-//! reduced after (reduce.rs). The CFL rule itself is [`next_step_size`].
+//! velocities from the positions, the new positions, the densities at them, the vorticity
+//! confinement where it is on (§15, shaders/vorticity.wgsl), the XSPH filter, and the
+//! per-particle values of the step's density errors and of the CFL rule, reduced after
+//! (reduce.rs). The CFL rule itself is [`next_step_size`].
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
 use crate::params::Params;
 
-/// The finishing kernels with a bind group for each iterate buffer holding the result.
+/// The finishing kernels with a bind group for each iterate buffer holding the result, and
+/// the vorticity confinement's where it is on.
 pub(super) struct Finish {
     kernel: Kernel,
     groups: Vec<wgpu::BindGroup>,
+    vorticity: Option<Vorticity>,
+}
+
+/// The vorticity confinement's kernels (`vorticity`, `confine`) and their bind group.
+struct Vorticity {
+    kernel: Kernel,
+    group: Option<wgpu::BindGroup>,
 }
 
 impl Finish {
-    pub fn new(ctx: &Context) -> Self {
+    /// The finishing kernels, with the vorticity confinement's where `confine` (its ε > 0).
+    pub fn new(ctx: &Context, confine: bool) -> Self {
         let mut slots = vec![Slot::Uniform, Slot::Uniform];
         slots.extend([Slot::Storage; 11]);
         let kernel = ctx.kernel(
@@ -23,9 +33,23 @@ impl Finish {
             &slots,
             &["update", "xsph"],
         );
+        let vorticity = confine.then(|| {
+            let mut slots = vec![Slot::Uniform];
+            slots.extend([Slot::Storage; 5]);
+            Vorticity {
+                kernel: ctx.kernel(
+                    "vorticity",
+                    with_common!("shaders/vorticity.wgsl"),
+                    &slots,
+                    &["vorticity", "confine"],
+                ),
+                group: None,
+            }
+        });
         Finish {
             kernel,
             groups: Vec::new(),
+            vorticity,
         }
     }
 
@@ -55,15 +79,34 @@ impl Finish {
                 )
             })
             .collect();
+        if let Some(v) = &mut self.vorticity {
+            v.group = Some(ctx.bind(
+                &v.kernel,
+                &[
+                    &b.params,
+                    &b.x,
+                    &b.v,
+                    &b.fluid_offset,
+                    &b.fluid_list,
+                    &b.vorticity,
+                ],
+            ));
+        }
     }
 
-    /// Records the update from the result in `b.iterates[result]` and the XSPH filter, whose
-    /// velocities are copied back into `b.v`.
+    /// Records the update from the result in `b.iterates[result]`, the vorticity
+    /// confinement where it is on and the XSPH filter, whose velocities are copied back
+    /// into `b.v`.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             let group = &self.groups[result];
             dispatch(&mut pass, &self.kernel.pipelines[0], group, b.n);
+            if let Some(v) = &self.vorticity {
+                let confine = v.group.as_ref().expect("Finish::bind runs before a step");
+                dispatch(&mut pass, &v.kernel.pipelines[0], confine, b.n);
+                dispatch(&mut pass, &v.kernel.pipelines[1], confine, b.n);
+            }
             dispatch(&mut pass, &self.kernel.pipelines[1], group, b.n);
         }
         encoder.copy_buffer_to_buffer(&b.v_out, 0, &b.v, 0, u64::from(b.n) * 16);

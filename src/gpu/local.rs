@@ -1,6 +1,7 @@
 //! The local step on the device (docs/method.md §2.5, shaders/project.wgsl): every density
 //! constraint projected at the iterate X^(k), one thread per constraint; single-step
-//! projections keep λ_i, multi-step ones their stencil's corrections. The gather of those
+//! projections keep λ_i, multi-step ones their stencil's corrections; each member's weight
+//! is divided by its material's mass ratio (docs/method.md §14). The gather of those
 //! corrections is part of the global step (global.rs), which reads them from the
 //! particle's side.
 
@@ -16,7 +17,7 @@ pub(super) struct LocalStep {
 impl LocalStep {
     pub fn new(ctx: &Context) -> Self {
         let mut slots = vec![Slot::Uniform];
-        slots.extend([Slot::Storage; 11]);
+        slots.extend([Slot::Storage; 12]);
         let kernel = ctx.kernel(
             "project",
             with_common!("shaders/project.wgsl"),
@@ -50,6 +51,7 @@ impl LocalStep {
                         &b.flags,
                         &b.kept,
                         &b.values,
+                        &b.material,
                     ],
                 )
             })

@@ -9,11 +9,18 @@
 //! by index), sums in a fixed tree, and every per-particle sum gathered by the particle
 //! itself in the order of its neighbour list.
 //!
+//! It steps worlds without bodies, emitters, walls built as fields and the physical
+//! viscosity, with Chebyshev's solver or one Jacobi sweep (without the warm start and the
+//! coarse correction, stepper.rs): the fluid and the static boundary as particles, with
+//! several materials (their mass ratios dividing the projection weights, §14), vorticity
+//! confinement (§15) and XSPH.
+//!
 //! One file per stage: [`context`] (device, kernels, read-backs), [`buffers`] (the state on
 //! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists), [`local`]
 //! (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`] (the
-//! reductions of the stopping rules and statistics), [`finish`] (velocities, densities, XSPH,
-//! CFL) and [`stepper`] (the step in order). Shaders are in `shaders/`.
+//! reductions of the stopping rules and statistics), [`finish`] (velocities, densities,
+//! vorticity confinement, XSPH, CFL) and [`stepper`] (the step in order). Shaders are in
+//! `shaders/`.
 
 /// A shader's WGSL source with shaders/common.wgsl (the step's constants, the kernel, the
 /// grid) before it.

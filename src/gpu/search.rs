@@ -1,8 +1,9 @@
 //! The neighbour phase on the device (docs/method.md §1.3 steps 1–2, §6): the prediction
-//! s, the counting sort of the fluid by cell (shaders/sort.wgsl, then every array gathered
-//! into the sort's order, shaders/permute.wgsl) and the fluid and boundary neighbour lists
-//! on s (shaders/neighbors.wgsl), counted, laid out by prefix sums (scan.rs) and filled.
-//! The lists' total is read back once per step to size them.
+//! s, the counting sort of the fluid by cell (shaders/sort.wgsl, then every array, the
+//! particles' materials too, gathered into the sort's order, shaders/permute.wgsl) and the
+//! fluid and boundary neighbour lists on s (shaders/neighbors.wgsl), counted, laid out by
+//! prefix sums (scan.rs) and filled. The lists' total is read back once per step to size
+//! them.
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
@@ -32,7 +33,7 @@ impl Search {
         let storage =
             |n| std::iter::once(Slot::Uniform).chain(std::iter::repeat_n(Slot::Storage, n));
         let sort_slots: Vec<_> = storage(8).collect();
-        let permute_slots: Vec<_> = storage(9).collect();
+        let permute_slots: Vec<_> = storage(11).collect();
         let neighbor_slots: Vec<_> = storage(10).collect();
         Search {
             sort: ctx.kernel(
@@ -78,8 +79,18 @@ impl Search {
             permute: ctx.bind(
                 &self.permute,
                 &[
-                    &b.params, &b.order, &b.x, &b.v, &b.s, &b.ids, &b.x_out, &b.v_out, &b.s_out,
+                    &b.params,
+                    &b.order,
+                    &b.x,
+                    &b.v,
+                    &b.s,
+                    &b.ids,
+                    &b.x_out,
+                    &b.v_out,
+                    &b.s_out,
                     &b.ids_out,
+                    &b.material,
+                    &b.material_out,
                 ],
             ),
             neighbors: ctx.bind(
@@ -133,6 +144,7 @@ impl Search {
         encoder.copy_buffer_to_buffer(&b.v_out, 0, &b.v, 0, bytes(b.n, 16));
         encoder.copy_buffer_to_buffer(&b.s_out, 0, &b.s, 0, bytes(b.n, 16));
         encoder.copy_buffer_to_buffer(&b.ids_out, 0, &b.ids, 0, bytes(b.n, 4));
+        encoder.copy_buffer_to_buffer(&b.material_out, 0, &b.material, 0, bytes(b.n, 4));
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             dispatch(&mut pass, &self.neighbors.pipelines[0], &g.neighbors, b.n);

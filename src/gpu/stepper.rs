@@ -4,10 +4,15 @@
 //! Chebyshev's extrapolation (global.rs) until a stopping rule holds (§4, read back once
 //! per outer iteration through reduce.rs), and the end of the step (finish.rs).
 //!
+//! Several materials (§14) enter through the projection weights, as on the CPU: every slot
+//! holds its particle's material, permuted with it, and [`StepParams::inverse_ratio`] the
+//! materials' m/m_k. Vorticity confinement (§15) runs in the end of the step where its ε is
+//! set.
+//!
 //! Left out for now, as CPU-only extras that are off by default: the warm start (§4.1) and
 //! the coarse correction (§3.8); a GPU step always starts from s.
 
-use super::buffers::{Buffers, Grid, IterParams, StepParams};
+use super::buffers::{Buffers, Grid, IterParams, MATERIAL_SLOTS, StepParams};
 use super::context::{Context, floats, words};
 use super::finish::{Finish, next_step_size};
 use super::global::GlobalStep;
@@ -15,6 +20,7 @@ use super::local::LocalStep;
 use super::reduce::Reduction;
 use super::search::Search;
 use crate::boundary::Aabb;
+use crate::material::MaterialId;
 use crate::params::{Params, ProjectionWeight, SolverKind};
 use crate::solver::Chebyshev;
 use crate::stats::{StepStats, StepTimings};
@@ -35,6 +41,10 @@ pub(crate) struct Scene<'a> {
     pub boundary: &'a [Vec3],
     pub psi: &'a [f64],
     pub params: &'a Params,
+    /// Every fluid particle's material, in the order of `positions`.
+    pub materials: &'a [MaterialId],
+    /// Every material's mass ratio m_k/m = ρ0_k/ρ0 (dimensionless), by id.
+    pub mass_ratios: &'a [f64],
     /// Fluid particle mass m (kg).
     pub mass: f64,
     /// The fewest stencils the global step counts a particle in (docs/method.md §3.1).
@@ -92,14 +102,16 @@ impl GpuStepper {
             });
         let grid = Grid::covering(bounds, h);
         let (boundary, boundary_start) = sort_boundary(&grid, scene.boundary, scene.psi);
-        let buffers = Buffers::new(&ctx, n, grid.cells(), &boundary, &boundary_start);
+        let confine = params.vorticity_confinement > 0.0;
+        let cells = grid.cells();
+        let buffers = Buffers::new(&ctx, n, cells, &boundary, &boundary_start, confine);
         let constants = constants(&params, &grid, scene, boundary.len() as u32);
         let reduction = Reduction::new(&ctx, n, &buffers.values);
         let mut stepper = GpuStepper {
             search: Search::new(&ctx),
             local: LocalStep::new(&ctx),
             global: GlobalStep::new(&ctx),
-            finish: Finish::new(&ctx),
+            finish: Finish::new(&ctx, confine),
             reduction,
             chebyshev: Chebyshev::new(params.chebyshev),
             params,
@@ -110,7 +122,7 @@ impl GpuStepper {
             ctx,
         };
         stepper.bind();
-        stepper.upload(scene.positions, scene.velocities)?;
+        stepper.upload(scene.positions, scene.velocities, scene.materials)?;
         Ok(stepper)
     }
 
@@ -127,9 +139,14 @@ impl GpuStepper {
         self.finish.bind(ctx, b);
     }
 
-    /// Replaces the fluid's positions (m) and velocities (m/s), as many as the stepper has;
-    /// each slot's particle index restarts from its place in these arrays.
-    pub fn upload(&mut self, positions: &[Vec3], velocities: &[Vec3]) -> Result<(), Error> {
+    /// Replaces the fluid's positions (m), velocities (m/s) and materials, as many as the
+    /// stepper has; each slot's particle index restarts from its place in these arrays.
+    pub fn upload(
+        &mut self,
+        positions: &[Vec3],
+        velocities: &[Vec3],
+        materials: &[MaterialId],
+    ) -> Result<(), Error> {
         let b = &self.buffers;
         let x: Vec<[f32; 4]> = positions
             .iter()
@@ -140,6 +157,7 @@ impl GpuStepper {
             .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0])
             .collect();
         let ids: Vec<u32> = (0..b.n).collect();
+        let materials: Vec<u32> = materials.iter().map(|&m| u32::from(m)).collect();
         self.ctx
             .queue
             .write_buffer(&b.x, 0, bytemuck::cast_slice(&x));
@@ -149,6 +167,9 @@ impl GpuStepper {
         self.ctx
             .queue
             .write_buffer(&b.ids, 0, bytemuck::cast_slice(&ids));
+        self.ctx
+            .queue
+            .write_buffer(&b.material, 0, bytemuck::cast_slice(&materials));
         self.ctx.check()
     }
 
@@ -356,6 +377,15 @@ fn constants(params: &Params, grid: &Grid, scene: Scene, boundary_n: u32) -> Ste
     let h = params.support_radius();
     let kernel = crate::kernel::CubicKernel::new(h);
     let g = params.gravity;
+    // m/m_k of every material (at most MATERIAL_SLOTS, as a world holds no more).
+    let mut inverse_ratio = [[0.0f32; 4]; MATERIAL_SLOTS / 4];
+    for (slot, ratio) in inverse_ratio
+        .as_flattened_mut()
+        .iter_mut()
+        .zip(scene.mass_ratios)
+    {
+        *slot = (1.0 / ratio) as f32;
+    }
     StepParams {
         n: scene.positions.len() as u32,
         boundary_n,
@@ -386,7 +416,8 @@ fn constants(params: &Params, grid: &Grid, scene: Scene, boundary_n: u32) -> Ste
         viscosity: params.viscosity as f32,
         rest_stencil: params.rest_stencil_size() as f32,
         newton_limit: (0.25 * h) as f32,
-        pad: 0.0,
+        vorticity: params.vorticity_confinement as f32,
+        inverse_ratio,
     }
 }
 

@@ -16,10 +16,11 @@ pub enum Backend {
     /// The world's own thread pool, in double precision (the default).
     #[default]
     Cpu,
-    /// A graphics card through Vulkan compute shaders, in single precision (feature `gpu`).
-    /// Not yet with bodies, emitters, walls built as fields or the physical viscosity; the
-    /// solver is Chebyshev's or one Jacobi sweep. The warm start and the coarse correction
-    /// are left out on it (docs/method.md §4.1, §3.8).
+    /// A graphics card through Vulkan compute shaders, in single precision (feature `gpu`),
+    /// with several materials and vorticity confinement as on the CPU. Not yet with bodies,
+    /// emitters, walls built as fields or the physical viscosity; the solver is Chebyshev's
+    /// or one Jacobi sweep. The warm start and the coarse correction are left out on it
+    /// (docs/method.md §4.1, §3.8).
     Gpu,
 }
 
@@ -122,6 +123,7 @@ impl World {
             self.gpu = Some(Box::new(GpuSlot {
                 context: None,
                 boundary_len: usize::MAX,
+                material_count: 0,
             }));
             // The device is opened now, so that a missing adapter is reported here.
             if let Err(e) = crate::gpu::probe() {
@@ -151,25 +153,21 @@ impl World {
         if self.params.kinematic_viscosity > 0.0 {
             return refuse("the physical viscosity (kinematic_viscosity)");
         }
-        if self.params.vorticity_confinement > 0.0 {
-            return refuse("vorticity confinement (vorticity_confinement)");
-        }
-        if !self.materials.single() {
-            return refuse("several fluid materials");
-        }
         Ok(())
     }
 
     /// One step of `dt` seconds on the device, after [`World::prepare_steps`]: the fluid is
-    /// uploaded (the stepper made again where the particles changed in number), stepped and
-    /// read back, then sinks and the domain remove what left.
+    /// uploaded (the stepper made again where the particles or the materials changed in
+    /// number), stepped and read back, then sinks and the domain remove what left.
     #[cfg(feature = "gpu")]
     pub(super) fn take_gpu_step(&mut self, dt: f64) -> Result<&crate::stats::StepStats, Error> {
         self.check_gpu_world()?;
         let fluid_len = self.fluid.len();
         let boundary_len = self.boundary.len();
         let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
+        let material_count = self.materials.len();
         let stale = slot.boundary_len != boundary_len
+            || slot.material_count != material_count
             || slot.context.as_ref().is_none_or(|s| s.len() != fluid_len);
         if stale {
             slot.context = None;
@@ -179,6 +177,8 @@ impl World {
                 velocities: &self.fluid.velocities,
                 boundary: &points,
                 psi: &psi,
+                materials: &self.fluid.materials,
+                mass_ratios: &self.materials.mass_ratios,
                 params: &self.params,
                 mass: self.constraint.mass,
                 membership_floor: self.constraint.membership_floor,
@@ -187,15 +187,23 @@ impl World {
             let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
             slot.context = Some(stepper);
             slot.boundary_len = boundary_len;
+            slot.material_count = material_count;
         } else if let Some(stepper) = slot.context.as_mut() {
-            stepper.upload(&self.fluid.positions, &self.fluid.velocities)?;
+            let fluid = &self.fluid;
+            stepper.upload(&fluid.positions, &fluid.velocities, &fluid.materials)?;
         }
         let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
         let stepper = slot.context.as_mut().expect("made above");
         let (stats, next_dt) = stepper.step(dt)?;
         let back = stepper.read()?;
         let fluid = &mut self.fluid;
+        // The device's order: every per-particle array the world keeps follows it (the
+        // materials of a world of one are all 0 already).
         let ids: Vec<u64> = back.order.iter().map(|&k| fluid.ids[k as usize]).collect();
+        if !self.materials.single() {
+            let materials = back.order.iter().map(|&k| fluid.materials[k as usize]);
+            fluid.materials = materials.collect();
+        }
         fluid.ids = ids;
         fluid.positions = back.positions;
         fluid.velocities = back.velocities;
@@ -230,12 +238,14 @@ impl World {
 }
 
 /// The GPU backend's state in a world: the stepper, made at the first step and again when
-/// the particles change in number.
+/// the particles or the materials change in number.
 #[cfg(feature = "gpu")]
 pub(crate) struct GpuSlot {
     context: Option<crate::gpu::GpuStepper>,
     /// Boundary particles the stepper was made with.
     boundary_len: usize,
+    /// Materials the stepper was made with (their mass ratios are among its constants).
+    material_count: usize,
 }
 
 #[cfg(test)]

@@ -10,10 +10,8 @@ impl World {
     /// fluid, of [`crate::Params::rest_density`]). Fluid of it is added after
     /// [`World::set_fluid_material`] chooses it. Errors, changing nothing, on a rest density
     /// that is not finite or lies outside [`crate::material::DENSITY_RATIO_RANGE`] times the
-    /// world's, on more than [`crate::material::MAX_MATERIALS`] materials, or on a world on
-    /// the GPU backend, which steps one material only.
+    /// world's, or on more than [`crate::material::MAX_MATERIALS`] materials.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
-        self.refuse_on_gpu("several fluid materials")?;
         self.materials.add(material, self.params.rest_density)
     }
 

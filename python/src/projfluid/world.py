@@ -225,8 +225,8 @@ class World(BodiesMixin, FlowMixin):
         world's ``rest_density``), and returns its id: 1 for the first one added, then 2,
         3, …; material 0 is the world's own fluid. Fluid of it is made after
         :meth:`set_fluid_material` chooses it. A rest density that is not finite or out of
-        range, a 257th material, or a world on the GPU backend (which steps one material)
-        raises :class:`~projfluid.errors.InvalidArgumentError` and adds nothing."""
+        range, or a 257th material, raises :class:`~projfluid.errors.InvalidArgumentError`
+        and adds nothing."""
         out = c_uint16()
         self._call(lib.pf_world_add_material, float(rest_density), byref(out))
         return out.value

@@ -29,9 +29,9 @@ fn unknown_material(material: MaterialId, count: usize) -> Failure {
 ///
 /// Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
 /// rest density that is not finite or lies outside 0.1 to 10 times the world's rest
-/// density, the message giving the range in kg/m³; a world holding 256 materials already;
-/// a world on the GPU backend, which steps one material only). On any error no material is
-/// added and `*out` is untouched. Thread safety: one thread at a time per world.
+/// density, the message giving the range in kg/m³; a world holding 256 materials already).
+/// On any error no material is added and `*out` is untouched. Thread safety: one thread at a
+/// time per world.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.

@@ -25,11 +25,15 @@ struct StepParams {
     rest_density: f32,
     dt2k: f32,
     membership_floor: f32,
-    // XSPH c_X, the rest stencil size c, the Newton step limit H/4 (m), unused.
+    // XSPH c_X, the rest stencil size c, the Newton step limit H/4 (m), the vorticity
+    // confinement's ε (docs/method.md §15; 0 = off).
     viscosity: f32,
     rest_stencil: f32,
     newton_limit: f32,
-    pad: f32,
+    vorticity: f32,
+    // m/m_k = ρ0/ρ0_k of every material k, four to an entry (docs/method.md §14): the
+    // factor that divides a particle's projection weight by its mass ratio.
+    inverse_ratio: array<vec4<f32>, 64>,
 }
 
 const WORKGROUP: u32 = 256u;
@@ -73,13 +77,22 @@ fn item(wid: vec3<u32>, nwg: vec3<u32>, lid: u32) -> u32 {
     return (wid.y * nwg.x + wid.x) * WORKGROUP + lid;
 }
 
-// The projection weight w_j of a particle with `count` fluid neighbours (docs/method.md §2.5).
-fn weight(count: u32) -> f32 {
+// The projection weight of a particle with `count` fluid neighbours before its material's
+// mass ratio enters (docs/method.md §2.5).
+fn plain_weight(count: u32) -> f32 {
     switch P.weight_mode {
         case 1u: { return 1.0; }
         case 2u: { return P.rest_stencil; }
         default: { return f32(count + 1u); }
     }
+}
+
+// The projection weight w_j of a particle with `count` fluid neighbours, of material
+// `material`: the plain weight divided by the material's mass ratio m_k/m, so that a heavier
+// liquid yields less to the same constraint (docs/method.md §14; 1 for the world's own fluid,
+// which leaves the weight's bits as they are).
+fn weight(count: u32, material: u32) -> f32 {
+    return plain_weight(count) * P.inverse_ratio[material >> 2u][material & 3u];
 }
 
 // μ_j, the stencils the global step counts particle j in (docs/method.md §3.1).

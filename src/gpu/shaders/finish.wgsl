@@ -2,6 +2,8 @@
 // positions, the densities at them (unless the last local step evaluated them there), the
 // XSPH filter (Monaghan 1989) into `velocity_out`, and per particle the values the step's
 // statistics and the CFL rule reduce: max(ρ_i/ρ0 − 1, 0) in x and y, |v_i + Δt·g|² in z.
+// The vorticity confinement (vorticity.wgsl), where it is on, runs between `update` and
+// `xsph`.
 
 struct IterParams {
     omega: f32,

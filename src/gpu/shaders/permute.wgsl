@@ -1,5 +1,6 @@
-// Gathers the fluid's arrays into the order of the sort (sort.wgsl): slot k receives
-// particle order[k]. The results go to spare buffers, copied back after.
+// Gathers the fluid's arrays (positions, velocities, predictions, particle indices and
+// materials) into the order of the sort (sort.wgsl): slot k receives particle order[k]. The
+// results go to spare buffers, copied back after.
 
 @group(0) @binding(0) var<uniform> P: StepParams;
 @group(0) @binding(1) var<storage, read_write> order: array<u32>;
@@ -11,6 +12,8 @@
 @group(0) @binding(7) var<storage, read_write> v_out: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> s_out: array<vec4<f32>>;
 @group(0) @binding(9) var<storage, read_write> ids_out: array<u32>;
+@group(0) @binding(10) var<storage, read_write> material: array<u32>;
+@group(0) @binding(11) var<storage, read_write> material_out: array<u32>;
 
 @compute @workgroup_size(256)
 fn permute(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
@@ -24,4 +27,5 @@ fn permute(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
     v_out[k] = v[i];
     s_out[k] = s[i];
     ids_out[k] = ids[i];
+    material_out[k] = material[i];
 }

@@ -4,7 +4,8 @@
 // its corrections); a longer one writes its stencil's corrections P_{i,j} − x_j into its
 // segment of `kept` (own correction first, then one per fluid neighbour in list order) and
 // is flagged. ρ_i at the iterate goes to `density`, max(ρ_i/ρ0 − 1, 0) to values.x for the
-// density rule (§4).
+// density rule (§4). The constraint is the same for every material (its densities are in the
+// world's fluid's terms, §14); a particle's material enters through its weight alone.
 
 @group(0) @binding(0) var<uniform> P: StepParams;
 @group(0) @binding(1) var<storage, read_write> x: array<vec4<f32>>;
@@ -18,6 +19,7 @@
 @group(0) @binding(9) var<storage, read_write> flags: array<u32>;
 @group(0) @binding(10) var<storage, read_write> kept: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> values: array<vec4<f32>>;
+@group(0) @binding(12) var<storage, read_write> material: array<u32>;
 
 // The projection stops once C_i ≤ this (as on the CPU; in single precision it means the
 // constraint reads no compression at all).
@@ -26,8 +28,9 @@ const MAX_PROJECTION_STEPS: u32 = 100u;
 // ε of λ = −C/(|∇C|² + ε), m⁻².
 const REGULARIZATION: f32 = 1e-6;
 
+// w_j of fluid particle j (docs/method.md §2.5, §14).
 fn weight_of(j: u32) -> f32 {
-    return weight(fluid_offset[j + 1u] - fluid_offset[j]);
+    return weight(fluid_offset[j + 1u] - fluid_offset[j], material[j]);
 }
 
 // What moves member s (list entry e) of the stencil: 0 at the iterate (mode 0), the first
@@ -103,7 +106,7 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
     let members = fluid_offset[i + 1u] - first;
     // Segment of i in `kept`: its own correction, then one per neighbour.
     let seg = first + i;
-    let w_i = weight(members);
+    let w_i = weight(members, material[i]);
     var own = vec3<f32>(0.0);
     var first_lambda = 0.0;
     var materialized = false;

@@ -23,6 +23,7 @@ struct IterParams {
 @group(0) @binding(8) var<storage, read_write> flags: array<u32>;
 @group(0) @binding(9) var<storage, read_write> kept: array<vec4<f32>>;
 @group(0) @binding(10) var<storage, read_write> values: array<vec4<f32>>;
+@group(0) @binding(11) var<storage, read_write> material: array<u32>;
 
 // Σ_{i: j∈N̄_i} (P_{i,j} − X_j): every correction the local step made to particle j (m),
 // gathered from its own and its neighbours' projections (src/constraint/gather.rs).
@@ -40,7 +41,8 @@ fn gathered(j: u32, xj: vec3<f32>, count: u32) -> vec3<f32> {
             moved += r * (grad_coefficient(length(r)) * lambda);
         }
     }
-    var sum = projection[j].xyz + moved * (weight(count) * P.mass / P.rest_density);
+    let w_j = weight(count, material[j]);
+    var sum = projection[j].xyz + moved * (w_j * P.mass / P.rest_density);
     if near_kept {
         for (var e = first; e < first + count; e++) {
             let i = fluid_list[e];

@@ -1,11 +1,16 @@
-//! Reading frames back: the particle positions and the time of legacy VTK files, those
-//! projfluid writes (`--format vtk` or `vtk-ascii`, docs/method.md §10) and those of other
-//! solvers such as SPlisHSPlasH, so that the probes can be read on them
+//! Reading frames back: the particle positions and the time of the frames projfluid writes
+//! (`--format vtp`, the default, `vtk` or `vtk-ascii`) and of other solvers that write legacy
+//! VTK, such as SPlisHSPlasH, so that the probes can be read on them
 //! ([`projfluid::probe::ProbeSet::read_frame`]).
 //!
-//! Only what the probes need is read: `POINTS` (as `float` or `double`, binary big-endian or
-//! ASCII) and, where the file has one, the `TIME` field of its field data.
+//! Only what the probes need is read: the points and, where the file has one, its `TIME`
+//! field. Legacy VTK: `POINTS` as `float` or `double`, binary big-endian or ASCII. VTK XML
+//! PolyData (`.vtp`): `Points` and `TIME` as `Float32` or `Float64` arrays, inline `binary`
+//! (base64, a UInt32 or UInt64 byte count first, little-endian) or `ascii`; appended or
+//! compressed data are refused with the reason.
 
+use base64::Engine;
+use base64::engine::general_purpose::STANDARD;
 use projfluid::{Error, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -25,6 +30,153 @@ pub fn read_vtk_points(path: &Path) -> Result<FramePoints, Error> {
     let bytes = std::fs::read(path)
         .map_err(|e| Error::Io(format!("cannot read {}: {e}", path.display())))?;
     parse(&bytes).map_err(|why| Error::Io(format!("{}: {why}", path.display())))
+}
+
+/// Reads the points and time of the frame at `path`, a legacy VTK file (`.vtk`) or a VTK
+/// XML PolyData file (`.vtp`) by its extension. Errors name the path and what is wrong.
+pub fn read_frame_points(path: &Path) -> Result<FramePoints, Error> {
+    if path.extension().is_some_and(|x| x == "vtp") {
+        let bytes = std::fs::read(path)
+            .map_err(|e| Error::Io(format!("cannot read {}: {e}", path.display())))?;
+        parse_vtp(&String::from_utf8_lossy(&bytes))
+            .map_err(|why| Error::Io(format!("{}: {why}", path.display())))
+    } else {
+        read_vtk_points(path)
+    }
+}
+
+/// The frame in the VTK XML PolyData `text`, or why it cannot be read.
+fn parse_vtp(text: &str) -> Result<FramePoints, String> {
+    let root = start_tag(text, "VTKFile").ok_or("not a VTK XML file")?;
+    if attribute(root, "type") != Some("PolyData") {
+        return Err("not a PolyData file".into());
+    }
+    if attribute(root, "compressor").is_some() {
+        return Err("compressed data are not read".into());
+    }
+    if text.contains("<AppendedData") {
+        return Err("appended data are not read (only inline arrays)".into());
+    }
+    if attribute(root, "byte_order").is_some_and(|o| o != "LittleEndian") {
+        return Err("big-endian data are not read".into());
+    }
+    let header = match attribute(root, "header_type").unwrap_or("UInt32") {
+        "UInt32" => 4,
+        "UInt64" => 8,
+        other => return Err(format!("header type `{other}`")),
+    };
+    let time = match text.find("<FieldData") {
+        Some(at) => named_array(&text[at..], "TIME")
+            .map(|array| array.values(header, 1).map(|v| v[0]))
+            .transpose()?,
+        None => None,
+    };
+    let piece = start_tag(text, "Piece").ok_or("no Piece")?;
+    let n: usize = attribute(piece, "NumberOfPoints")
+        .and_then(|n| n.parse().ok())
+        .ok_or("no number of points")?;
+    let at = text.find("<Points").ok_or("no Points")?;
+    let array = first_array(&text[at..]).ok_or("no Points array")?;
+    let xyz = array.values(header, 3 * n)?;
+    let positions = xyz
+        .chunks_exact(3)
+        .map(|c| Vec3::new(c[0], c[1], c[2]))
+        .collect();
+    Ok(FramePoints { time, positions })
+}
+
+/// One `DataArray` element of a VTK XML file: its start tag and its text.
+struct XmlArray<'a> {
+    tag: &'a str,
+    body: &'a str,
+}
+
+impl XmlArray<'_> {
+    /// `count` values of the array (`Float32` or `Float64`; `binary` with byte counts of
+    /// `header` bytes, or `ascii`), each finite.
+    fn values(&self, header: usize, count: usize) -> Result<Vec<f64>, String> {
+        let kind = attribute(self.tag, "type").unwrap_or("");
+        let width = match kind {
+            "Float32" => 4,
+            "Float64" => 8,
+            _ => {
+                return Err(format!(
+                    "an array of type `{kind}` (not Float32 or Float64)"
+                ));
+            }
+        };
+        let values: Vec<f64> = match attribute(self.tag, "format") {
+            Some("binary") => {
+                let bytes = STANDARD
+                    .decode(self.body.split_whitespace().collect::<String>())
+                    .map_err(|e| format!("bad base64: {e}"))?;
+                let data = bytes.get(header..).unwrap_or_default();
+                if data.len() < count * width {
+                    return Err("an array ends before its values do".into());
+                }
+                data[..count * width]
+                    .chunks_exact(width)
+                    .map(|c| match width {
+                        4 => f64::from(f32::from_le_bytes(c.try_into().expect("four bytes"))),
+                        _ => f64::from_le_bytes(c.try_into().expect("eight bytes")),
+                    })
+                    .collect()
+            }
+            Some("ascii") => {
+                let words: Vec<&str> = self.body.split_whitespace().take(count).collect();
+                if words.len() < count {
+                    return Err("an array ends before its values do".into());
+                }
+                words
+                    .iter()
+                    .map(|w| w.parse().map_err(|_| format!("`{w}` is not a number")))
+                    .collect::<Result<_, _>>()?
+            }
+            other => return Err(format!("array format {other:?} (not binary or ascii)")),
+        };
+        match values.iter().position(|v| !v.is_finite()) {
+            Some(i) => Err(format!("value {i} of {kind}s is not finite")),
+            None => Ok(values),
+        }
+    }
+}
+
+/// The start tag (between `<` and `>`) of the first element `name` in `text`.
+fn start_tag<'a>(text: &'a str, name: &str) -> Option<&'a str> {
+    let at = text.find(&format!("<{name}"))?;
+    let end = text[at..].find('>')?;
+    Some(&text[at + 1..at + end])
+}
+
+/// The first `DataArray` in `text`.
+fn first_array(text: &str) -> Option<XmlArray<'_>> {
+    let tag = start_tag(text, "DataArray")?;
+    let start = text.find(tag)? + tag.len() + 1;
+    let end = start + text[start..].find("</DataArray>")?;
+    Some(XmlArray {
+        tag,
+        body: &text[start..end],
+    })
+}
+
+/// The first `DataArray` in `text` whose `Name` is `name`.
+fn named_array<'a>(mut text: &'a str, name: &str) -> Option<XmlArray<'a>> {
+    loop {
+        let array = first_array(text)?;
+        if attribute(array.tag, "Name") == Some(name) {
+            return Some(array);
+        }
+        let next = text.find("</DataArray>")? + "</DataArray>".len();
+        text = &text[next..];
+    }
+}
+
+/// The value of attribute `name` in the start tag `tag`.
+fn attribute<'a>(tag: &'a str, name: &str) -> Option<&'a str> {
+    let key = format!(" {name}=\"");
+    let at = tag.find(&key)? + key.len();
+    let end = tag[at..].find('"')?;
+    Some(&tag[at..at + end])
 }
 
 /// The frame in `bytes`, or why it cannot be read.
@@ -125,20 +277,35 @@ impl Cursor<'_> {
     }
 }
 
-/// The legacy VTK files (`*.vtk`) in `dir`, in the order of the last number in their names
-/// (`frame_00012.vtk`, `ParticleData_Fluid_12.vtk`), names without one last. Errors name the
-/// directory when it cannot be read or holds no such file.
-pub fn vtk_files(dir: &Path) -> Result<Vec<PathBuf>, Error> {
+/// The frames in `dir`: its `.vtk` files or its `.vtp` files, in the order of the last number
+/// in their names (`frame_00012.vtp`, `ParticleData_Fluid_12.vtk`), names without one last.
+/// Errors name the directory when it cannot be read, holds neither kind or holds both.
+pub fn frame_files(dir: &Path) -> Result<Vec<PathBuf>, Error> {
     let entries = std::fs::read_dir(dir)
         .map_err(|e| Error::Io(format!("cannot read directory {}: {e}", dir.display())))?;
-    let mut files: Vec<(Option<u64>, PathBuf)> = entries
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "vtk"))
-        .map(|p| (last_number(&p), p))
-        .collect();
-    if files.is_empty() {
-        return Err(Error::Io(format!("no .vtk files in {}", dir.display())));
-    }
+    let paths: Vec<PathBuf> = entries.filter_map(|e| e.ok().map(|e| e.path())).collect();
+    let of_kind = |kind: &str| -> Vec<(Option<u64>, PathBuf)> {
+        (paths.iter())
+            .filter(|p| p.extension().is_some_and(|x| x == kind))
+            .map(|p| (last_number(p), p.clone()))
+            .collect()
+    };
+    let mut files = match (of_kind("vtk"), of_kind("vtp")) {
+        (vtk, vtp) if vtk.is_empty() && vtp.is_empty() => {
+            return Err(Error::Io(format!(
+                "no .vtk or .vtp frames in {}",
+                dir.display()
+            )));
+        }
+        (vtk, vtp) if vtp.is_empty() => vtk,
+        (vtk, vtp) if vtk.is_empty() => vtp,
+        _ => {
+            return Err(Error::Io(format!(
+                "{} holds both .vtk and .vtp frames: keep one kind",
+                dir.display()
+            )));
+        }
+    };
     files.sort_by(|a, b| match (a.0, b.0) {
         (Some(x), Some(y)) => x.cmp(&y).then_with(|| a.1.cmp(&b.1)),
         (Some(_), None) => std::cmp::Ordering::Less,
@@ -229,7 +396,56 @@ mod tests {
         assert!(parse(none).unwrap_err().contains("no POINTS"));
     }
 
-    /// Files sort by the last number in their names, not as text.
+    /// What projfluid writes as VTK XML reads back through [`read_frame_points`]: the time
+    /// exactly, the points as f32 rounds them. An ASCII file with a UInt32 header type reads;
+    /// compressed, appended and big-endian files are refused with the reason.
+    #[test]
+    fn vtp_frames_read_back() {
+        let dir = std::env::temp_dir().join(format!("pf_vtp_{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let x = points();
+        let (v, rho) = (vec![Vec3::zeros(); 3], vec![1000.0; 3]);
+        let path = dir.join("frame_00003.vtp");
+        projfluid::io::write_vtp(&path, &Frame::new(1.625, &x, &v, &rho)).unwrap();
+        let frame = read_frame_points(&path).unwrap();
+        assert_eq!(frame.time, Some(1.625));
+        let rounded: Vec<Vec3> = x.iter().map(|p| p.map(|c| c as f32 as f64)).collect();
+        assert_eq!(frame.positions, rounded);
+        std::fs::remove_dir_all(&dir).unwrap();
+
+        let ascii = "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"1.0\">\n\
+                     <PolyData><Piece NumberOfPoints=\"2\"><Points>\n\
+                     <DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n\
+                     0.5 1 1.5\n-2 0 4.25\n</DataArray></Points></Piece></PolyData></VTKFile>\n";
+        let frame = parse_vtp(ascii).unwrap();
+        assert_eq!(frame.time, None);
+        let expected = [Vec3::new(0.5, 1.0, 1.5), Vec3::new(-2.0, 0.0, 4.25)];
+        assert_eq!(frame.positions, expected);
+        let refused = [
+            (
+                "type=\"PolyData\"",
+                "type=\"PolyData\" compressor=\"vtkZLibDataCompressor\"",
+                "compressed",
+            ),
+            ("<PolyData>", "<PolyData><AppendedData/>", "appended"),
+            (
+                "version=\"1.0\"",
+                "version=\"1.0\" byte_order=\"BigEndian\"",
+                "big-endian",
+            ),
+            ("-2 0 4.25", "-2 0", "ends before"),
+            ("Float64", "Int32", "`Int32`"),
+            ("<Points>", "<Dots>", "no Points"),
+        ];
+        for (from, to, why) in refused {
+            let e = parse_vtp(&ascii.replace(from, to)).unwrap_err();
+            assert!(e.contains(why), "{to}: {e}");
+        }
+        assert!(parse_vtp("<html/>").unwrap_err().contains("not a VTK XML"));
+    }
+
+    /// Files sort by the last number in their names, not as text; a directory of both kinds
+    /// is refused.
     #[test]
     fn files_sort_by_their_numbers() {
         let dir = std::env::temp_dir().join(format!("pf_frame_order_{}", std::process::id()));
@@ -237,13 +453,16 @@ mod tests {
         for name in ["F_10.vtk", "F_2.vtk", "F_1.vtk", "notes.txt", "extra.vtk"] {
             std::fs::write(dir.join(name), "").unwrap();
         }
-        let names: Vec<String> = vtk_files(&dir)
+        let names: Vec<String> = frame_files(&dir)
             .unwrap()
             .iter()
             .map(|p| p.file_name().unwrap().to_string_lossy().into_owned())
             .collect();
         assert_eq!(names, ["F_1.vtk", "F_2.vtk", "F_10.vtk", "extra.vtk"]);
+        std::fs::write(dir.join("F_3.vtp"), "").unwrap();
+        let e = frame_files(&dir).unwrap_err().to_string();
+        assert!(e.contains("both .vtk and .vtp"), "{e}");
         std::fs::remove_dir_all(&dir).unwrap();
-        assert!(vtk_files(&dir).is_err());
+        assert!(frame_files(&dir).is_err());
     }
 }

@@ -1384,17 +1384,17 @@ fn bad_probes_exit_2() {
     std::fs::remove_dir_all(&dir).unwrap();
 }
 
-/// `projfluid probes` reads a scene's gauges on saved frames: on the frames of a run (legacy
-/// VTK, binary and ASCII) it reads what the run read at the same times, within the rounding of
-/// the frames' single-precision positions; frames without a time of their own need `--fps`,
-/// which numbers them k/fps; bad input exits 2 naming it.
+/// `projfluid probes` reads a scene's gauges on saved frames: on the frames of a run (VTK XML,
+/// legacy VTK binary and ASCII) it reads what the run read at the same times, within the
+/// rounding of the frames' single-precision positions; frames without a time of their own
+/// need `--fps`, which numbers them k/fps; bad input exits 2 naming it.
 #[test]
 fn probes_read_on_saved_frames() {
     let dir = temp_dir("probes-frames");
     let scene = dir.join("tank.json");
     std::fs::write(&scene, PROBE_TANK).unwrap();
     let scene = scene.to_str().unwrap();
-    for format in ["vtk", "vtk-ascii"] {
+    for format in ["vtp", "vtk", "vtk-ascii"] {
         let out = dir.join(format);
         let args = ["run", scene, "--fps", "50", "--format", format, "--out"];
         let run = projfluid(&[&args[..], &[out.to_str().unwrap()]].concat());

@@ -63,8 +63,8 @@ enum Command {
     Bench(bench::BenchArgs),
     /// Choose Chebyshev's ρ for a scene: estimate it, then sweep it.
     TuneRho(tune_rho::TuneRhoArgs),
-    /// Read a scene's probes on frames written earlier (legacy VTK, by projfluid or another
-    /// solver on the same geometry) and write their readings as CSV.
+    /// Read a scene's probes on frames written earlier (VTK XML or legacy VTK, by projfluid or
+    /// another solver on the same geometry) and write their readings as CSV.
     Probes(read_probes::ProbesArgs),
 }
 

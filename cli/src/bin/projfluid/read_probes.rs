@@ -1,12 +1,13 @@
 //! `projfluid probes SCENE --frames DIR`: reads the scene's probes on frames written earlier,
-//! by projfluid or by another solver on the same geometry (legacy VTK files), instead of
-//! during a run, and writes their readings in the layout of a run's `probes.csv`.
+//! by projfluid (VTK XML or legacy VTK) or by another solver on the same geometry (legacy
+//! VTK), instead of during a run, and writes their readings in the layout of a run's
+//! `probes.csv`.
 
 use crate::Failure;
 use crate::probes::{header, row};
 use clap::Args;
 use projfluid::scene::Scene;
-use projfluid_lab::frames::{read_vtk_points, vtk_files};
+use projfluid_lab::frames::{frame_files, read_frame_points};
 use std::path::PathBuf;
 
 /// Options of `projfluid probes`.
@@ -15,8 +16,8 @@ pub(crate) struct ProbesArgs {
     /// A built-in scene name (see `projfluid scenes`) or the path of a JSON scene file; its
     /// walls, obstacles and particle size are those of the frames, and its `probes` are read.
     scene: String,
-    /// Directory of legacy VTK frames (`*.vtk`), taken in the order of the numbers in their
-    /// names.
+    /// Directory of frames, VTK XML (`*.vtp`) or legacy VTK (`*.vtk`), taken in the order of
+    /// the numbers in their names.
     #[arg(long, value_name = "DIR")]
     frames: PathBuf,
     /// Frames per simulated second, for frames without a time of their own: the k-th file
@@ -51,10 +52,10 @@ pub(crate) fn read_probes(args: &ProbesArgs) -> Result<(), Failure> {
     }
     scene.params.threads = args.threads;
     let world = scene.build_world().map_err(input)?;
-    let files = vtk_files(&args.frames).map_err(input)?;
+    let files = frame_files(&args.frames).map_err(input)?;
     let mut text = header(&probes);
     for (k, file) in files.iter().enumerate() {
-        let frame = read_vtk_points(file).map_err(input)?;
+        let frame = read_frame_points(file).map_err(input)?;
         let time = match (frame.time, args.fps) {
             (Some(time), _) => time,
             (None, Some(fps)) => k as f64 / fps,

@@ -464,51 +464,30 @@ impl Fuzzer {
                 16..=18 => {
                     // Reads with random, often short, capacities and NULL outputs.
                     let needed_floats = 3 * fluid;
-                    let capacity = self.rng.below(needed_floats + 4);
-                    let mut buf = vec![-7.0f32; capacity];
-                    let mut needed = usize::MAX;
-                    let out = if capacity == 0 && self.rng.chance(50) {
-                        null_mut()
-                    } else {
-                        buf.as_mut_ptr()
-                    };
-                    let n = if self.rng.chance(20) {
-                        null_mut()
-                    } else {
-                        &mut needed
-                    };
-                    let (name, status, wanted) = match self.rng.below(3) {
-                        0 => (
-                            "get_positions",
-                            pf_world_get_positions(w, out, capacity, n),
-                            needed_floats,
-                        ),
-                        1 => (
-                            "get_velocities",
-                            pf_world_get_velocities(w, out, capacity, n),
-                            needed_floats,
-                        ),
-                        _ => (
-                            "get_densities",
-                            pf_world_get_densities(w, out, capacity, n),
-                            fluid,
-                        ),
-                    };
-                    match status {
-                        PfStatus::PF_OK => {
-                            assert!(capacity >= wanted, "{name}");
-                            assert!(buf[wanted..].iter().all(|&x| x == -7.0), "{name}");
-                            assert!(buf[..wanted].iter().all(|x| !x.is_nan()), "{name}: NaN");
-                        }
-                        PfStatus::PF_ERROR_BUFFER_TOO_SMALL => {
-                            assert!(capacity < wanted, "{name}");
-                            assert!(buf.iter().all(|&x| x == -7.0), "{name} wrote");
-                            if !n.is_null() {
-                                assert_eq!(needed, wanted, "{name}");
-                            }
-                        }
-                        _ => {}
-                    }
+                    let valid = |x: f32| !x.is_nan();
+                    let (name, status) = per_particle_read(
+                        &mut self.rng,
+                        needed_floats,
+                        -7.0f32,
+                        valid,
+                        |rng, out, capacity, n| match rng.below(3) {
+                            0 => (
+                                "get_positions",
+                                pf_world_get_positions(w, out, capacity, n),
+                                needed_floats,
+                            ),
+                            1 => (
+                                "get_velocities",
+                                pf_world_get_velocities(w, out, capacity, n),
+                                needed_floats,
+                            ),
+                            _ => (
+                                "get_densities",
+                                pf_world_get_densities(w, out, capacity, n),
+                                fluid,
+                            ),
+                        },
+                    );
                     (name, status, Moves::Nothing, 0)
                 }
                 19 => {
@@ -603,39 +582,18 @@ impl Fuzzer {
                             ("get_material_rest_density", status, Moves::Nothing, 0)
                         }
                         _ => {
-                            let capacity = self.rng.below(fluid + 4);
-                            let mut buf = vec![0xabcd_u16; capacity];
-                            let mut needed = usize::MAX;
-                            let out = if capacity == 0 && self.rng.chance(50) {
-                                null_mut()
-                            } else {
-                                buf.as_mut_ptr()
-                            };
-                            let n = if self.rng.chance(20) {
-                                null_mut()
-                            } else {
-                                &mut needed
-                            };
-                            let status = pf_world_get_materials(w, out, capacity, n);
-                            match status {
-                                PfStatus::PF_OK => {
-                                    assert!(capacity >= fluid, "get_materials");
-                                    assert!(buf[fluid..].iter().all(|&m| m == 0xabcd));
-                                    assert!(buf[..fluid].iter().all(|&m| m < 0xabcd));
-                                }
-                                PfStatus::PF_ERROR_BUFFER_TOO_SMALL => {
-                                    assert!(capacity < fluid, "get_materials");
-                                    assert!(
-                                        buf.iter().all(|&m| m == 0xabcd),
-                                        "get_materials wrote"
-                                    );
-                                    if !n.is_null() {
-                                        assert_eq!(needed, fluid, "get_materials");
-                                    }
-                                }
-                                _ => {}
-                            }
-                            ("get_materials", status, Moves::Nothing, 0)
+                            let valid = |m: u16| m < 0xabcd;
+                            let (name, status) = per_particle_read(
+                                &mut self.rng,
+                                fluid,
+                                0xabcd_u16,
+                                valid,
+                                |_, out, capacity, n| {
+                                    let status = pf_world_get_materials(w, out, capacity, n);
+                                    ("get_materials", status, fluid)
+                                },
+                            );
+                            (name, status, Moves::Nothing, 0)
                         }
                     }
                 }
@@ -643,6 +601,50 @@ impl Fuzzer {
             }
         }
     }
+}
+
+/// One of the per-particle reads with a random capacity below `room + 4` (often short),
+/// sometimes NULL outputs, and every slot of its buffer filled with `fill`: `read(rng, out,
+/// capacity, needed)` makes the call and returns its name, its status and how many values it
+/// owes. A success writes exactly those, each `valid`, and nothing past them; a short buffer
+/// writes nothing and reports the count where asked. Returns the name and the status.
+fn per_particle_read<T: Copy + PartialEq + std::fmt::Debug>(
+    rng: &mut Rng,
+    room: usize,
+    fill: T,
+    valid: impl Fn(T) -> bool,
+    read: impl FnOnce(&mut Rng, *mut T, usize, *mut usize) -> (&'static str, PfStatus, usize),
+) -> (&'static str, PfStatus) {
+    let capacity = rng.below(room + 4);
+    let mut buf = vec![fill; capacity];
+    let mut needed = usize::MAX;
+    let out = if capacity == 0 && rng.chance(50) {
+        null_mut()
+    } else {
+        buf.as_mut_ptr()
+    };
+    let n = if rng.chance(20) {
+        null_mut()
+    } else {
+        &mut needed
+    };
+    let (name, status, wanted) = read(rng, out, capacity, n);
+    match status {
+        PfStatus::PF_OK => {
+            assert!(capacity >= wanted, "{name}");
+            assert!(buf[wanted..].iter().all(|&x| x == fill), "{name}");
+            assert!(buf[..wanted].iter().all(|&x| valid(x)), "{name}: {buf:?}");
+        }
+        PfStatus::PF_ERROR_BUFFER_TOO_SMALL => {
+            assert!(capacity < wanted, "{name}");
+            assert!(buf.iter().all(|&x| x == fill), "{name} wrote");
+            if !n.is_null() {
+                assert_eq!(needed, wanted, "{name}");
+            }
+        }
+        _ => {}
+    }
+    (name, status)
 }
 
 /// One seeded run of `calls` random calls against a small world.

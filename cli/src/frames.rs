@@ -114,13 +114,7 @@ impl XmlArray<'_> {
                 if data.len() < count * width {
                     return Err("an array ends before its values do".into());
                 }
-                data[..count * width]
-                    .chunks_exact(width)
-                    .map(|c| match width {
-                        4 => f64::from(f32::from_le_bytes(c.try_into().expect("four bytes"))),
-                        _ => f64::from_le_bytes(c.try_into().expect("eight bytes")),
-                    })
-                    .collect()
+                decode(&data[..count * width], width, false)
             }
             Some("ascii") => {
                 let words: Vec<&str> = self.body.split_whitespace().take(count).collect();
@@ -134,10 +128,7 @@ impl XmlArray<'_> {
             }
             other => return Err(format!("array format {other:?} (not binary or ascii)")),
         };
-        match values.iter().position(|v| !v.is_finite()) {
-            Some(i) => Err(format!("value {i} of {kind}s is not finite")),
-            None => Ok(values),
-        }
+        finite(values, kind)
     }
 }
 
@@ -249,11 +240,7 @@ impl Cursor<'_> {
                 .ok_or("the file ends before its values do")?;
             let raw = &self.bytes[self.at..end];
             self.at = end;
-            let value = |c: &[u8]| match width {
-                4 => f64::from(f32::from_be_bytes(c.try_into().expect("four bytes"))),
-                _ => f64::from_be_bytes(c.try_into().expect("eight bytes")),
-            };
-            raw.chunks_exact(width).map(value).collect::<Vec<f64>>()
+            decode(raw, width, true)
         } else {
             let mut values = Vec::with_capacity(count.min(1 << 24));
             while values.len() < count {
@@ -270,10 +257,26 @@ impl Cursor<'_> {
             values.truncate(count);
             values
         };
-        match values.iter().position(|v| !v.is_finite()) {
-            Some(i) => Err(format!("value {i} of {kind}s is not finite")),
-            None => Ok(values),
-        }
+        finite(values, kind)
+    }
+}
+
+/// The `width`-byte floats (4 or 8) of `raw`, big- or little-endian, widened to f64.
+fn decode(raw: &[u8], width: usize, big_endian: bool) -> Vec<f64> {
+    let value = |c: &[u8]| match (width, big_endian) {
+        (4, true) => f64::from(f32::from_be_bytes(c.try_into().expect("four bytes"))),
+        (4, false) => f64::from(f32::from_le_bytes(c.try_into().expect("four bytes"))),
+        (_, true) => f64::from_be_bytes(c.try_into().expect("eight bytes")),
+        (_, false) => f64::from_le_bytes(c.try_into().expect("eight bytes")),
+    };
+    raw.chunks_exact(width).map(value).collect()
+}
+
+/// `values`, or an error naming the first that is not finite, of the type `kind`.
+fn finite(values: Vec<f64>, kind: &str) -> Result<Vec<f64>, String> {
+    match values.iter().position(|v| !v.is_finite()) {
+        Some(i) => Err(format!("value {i} of {kind}s is not finite")),
+        None => Ok(values),
     }
 }
 

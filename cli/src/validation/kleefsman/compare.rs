@@ -190,20 +190,20 @@ pub fn compare(
             simulated: interpolate(&h4, time),
         })
         .collect();
-    let rms_against = |g: usize, sim: Vec<(f64, f64)>| {
+    let rms_against = |g: usize, sim: &[(f64, f64)]| {
         let squares: Vec<f64> = data.heights[g]
             .iter()
             .filter(|&&(t, _)| t <= end)
-            .filter_map(|&(t, h)| interpolate(&sim, t).map(|s| (s - h).powi(2)))
+            .filter_map(|&(t, h)| interpolate(sim, t).map(|s| (s - h).powi(2)))
             .collect();
         (squares.iter().sum::<f64>() / squares.len().max(1) as f64).sqrt()
     };
     Comparison {
         arrivals,
         reservoir,
-        rms: std::array::from_fn(|g| rms_against(g, run.heights(g))),
+        rms: std::array::from_fn(|g| rms_against(g, &run.heights(g))),
         lee_content: arrival(LEE_GAUGE, run.contents(LEE_GAUGE)),
-        content_rms: std::array::from_fn(|g| rms_against(g, run.contents(g))),
+        content_rms: std::array::from_fn(|g| rms_against(g, &run.contents(g))),
         reference: ReferenceComparison {
             arrivals: ARRIVAL_GAUGES
                 .iter()
@@ -211,7 +211,7 @@ pub fn compare(
                     first_crossing(&reference.heights[g], ARRIVAL_LEVEL).filter(|&t| t <= end)
                 })
                 .collect(),
-            rms: std::array::from_fn(|g| rms_against(g, reference.heights[g].clone())),
+            rms: std::array::from_fn(|g| rms_against(g, &reference.heights[g])),
         },
         tolerances,
     }

@@ -908,6 +908,42 @@ enum PfStatus pf_world_get_material_rest_density(const struct PfWorld *world,
                                                  double *out);
 
 /**
+ * Sets the kinematic viscosity ν (m²/s) of `material` from the next step on: 0 leaves it
+ * without physical viscosity, water is 1e-6, honey 1e-2 and more (docs/method.md §13).
+ * Material 0 is the world's own fluid, whose `PfParams.kinematic_viscosity` was its
+ * viscosity so far; other materials start without one. Where two materials meet, the
+ * solve couples them with the harmonic mean of their viscosities.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
+ * the world does not have, the message giving the valid range; a viscosity that is
+ * negative or not finite; a viscosity above 0 in a world that steps on the GPU, which does
+ * not run the viscosity solve, the message starting "backend gpu"). On any error nothing
+ * changes. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`.
+ */
+enum PfStatus pf_world_set_material_kinematic_viscosity(struct PfWorld *world,
+                                                        uint16_t material,
+                                                        double kinematic_viscosity);
+
+/**
+ * Stores in `*out` the kinematic viscosity ν (m²/s) of `material`: for material 0
+ * `PfParams.kinematic_viscosity` until `pf_world_set_material_kinematic_viscosity` sets
+ * it, for the others 0 until it does.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+ * material the world does not have, the message giving the valid range); `*out` is then
+ * untouched.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_get_material_kinematic_viscosity(const struct PfWorld *world,
+                                                        uint16_t material,
+                                                        double *out);
+
+/**
  * Copies every fluid particle's material id into `out`, in ascending id order, the order
  * of every other per-particle read (`pf_world_get_positions`, `pf_world_get_densities`,
  * `pf_world_get_ids`, …). `capacity` is the length of `out` in ids; fluid count are needed

@@ -94,6 +94,10 @@ pub fn write_checkpoint(
             .map(|m| m.rest_density)
             .collect(),
         fluid_material: world.fluid_material(),
+        viscosities: (0..world.material_count())
+            .filter_map(|m| world.material(m as u16))
+            .map(|m| m.kinematic_viscosity)
+            .collect(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
@@ -267,7 +271,13 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let mut world = World::new(scene.params.clone())?;
     for &rest_density in &header.materials {
         world
-            .add_material(crate::Material { rest_density })
+            .add_material(crate::Material::with_density(rest_density))
+            .map_err(|e| bad(&format!("holds an invalid material: {e}")))?;
+    }
+    for (m, &nu) in header.viscosities.iter().enumerate() {
+        let id = u16::try_from(m).unwrap_or(u16::MAX);
+        world
+            .set_material_kinematic_viscosity(id, nu)
             .map_err(|e| bad(&format!("holds an invalid material: {e}")))?;
     }
     world

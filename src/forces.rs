@@ -6,6 +6,7 @@ use crate::Vec3;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
+use crate::material::Materials;
 use crate::params::Params;
 use viscosity::Viscosity;
 use vorticity::VorticityConfinement;
@@ -21,6 +22,8 @@ pub(crate) struct Forcing<'a> {
     pub constraint: &'a DensityConstraint,
     pub nb: &'a Neighborhood<'a>,
     pub boundary: &'a Boundary,
+    /// Each material's kinematic viscosity ν (m²/s), indexed by material.
+    pub viscosities: &'a [f64],
     /// Step size Δt (s).
     pub dt: f64,
 }
@@ -38,12 +41,12 @@ pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
     fn apply(&mut self, f: &Forcing, fluid: &mut Fluid, scratch: &mut Vec<Vec3>);
 }
 
-/// The non-pressure forces that `params` ask for, in the order they apply.
-pub(crate) fn from_params(params: &Params) -> Vec<Box<dyn NonPressureForce>> {
+/// The non-pressure forces that `params` and the `materials` ask for, in the order they
+/// apply: the physical viscosity where any material has one.
+pub(crate) fn of_world(params: &Params, materials: &Materials) -> Vec<Box<dyn NonPressureForce>> {
     let mut forces: Vec<Box<dyn NonPressureForce>> = Vec::new();
-    if params.kinematic_viscosity > 0.0 {
-        let walls = params.no_slip;
-        forces.push(Box::new(Viscosity::new(params.kinematic_viscosity, walls)));
+    if materials.viscous() {
+        forces.push(Box::new(Viscosity::new(params.no_slip)));
     }
     if params.vorticity_confinement > 0.0 {
         let epsilon = params.vorticity_confinement;

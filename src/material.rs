@@ -33,6 +33,19 @@ pub const DENSITY_RATIO_RANGE: (f64, f64) = (0.1, 10.0);
 pub struct Material {
     /// Rest density ρ0 (kg/m³).
     pub rest_density: f64,
+    /// Kinematic viscosity ν (m²/s) of the implicit viscosity solve (docs/method.md §13): 0
+    /// leaves the liquid without physical viscosity; water is 1e-6, honey 1e-2 and more.
+    pub kinematic_viscosity: f64,
+}
+
+impl Material {
+    /// A liquid of rest density `rest_density` (kg/m³) without physical viscosity.
+    pub fn with_density(rest_density: f64) -> Self {
+        Self {
+            rest_density,
+            kinematic_viscosity: 0.0,
+        }
+    }
 }
 
 impl Material {
@@ -52,8 +65,21 @@ impl Material {
                 ),
             ));
         }
-        Ok(())
+        check_viscosity(self.kinematic_viscosity)
     }
+}
+
+/// Errors, naming the field, where `nu` (m²/s) is not a kinematic viscosity a material may
+/// have: finite and not negative.
+pub(crate) fn check_viscosity(nu: f64) -> Result<(), Error> {
+    if nu.is_finite() && nu >= 0.0 {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        "kinematic_viscosity",
+        nu,
+        "must be finite and not negative (m²/s; 0 turns it off)",
+    ))
 }
 
 /// A world's materials beyond its own fluid, and the one that fluid added next is made of.
@@ -64,21 +90,23 @@ pub(crate) struct Materials {
     /// Every material's mass over the world's particle mass, ρ0_i/ρ0 (dimensionless),
     /// indexed by material: 1 for the world's own fluid.
     pub mass_ratios: Vec<f64>,
+    /// Every material's kinematic viscosity ν (m²/s), indexed by material.
+    pub viscosities: Vec<f64>,
     /// The material of the fluid added next: blocks, particles, and the emitters added next.
     pub current: MaterialId,
 }
 
-impl Default for Materials {
-    fn default() -> Self {
+impl Materials {
+    /// The materials of a world whose own fluid has kinematic viscosity `nu` (m²/s).
+    pub fn new(nu: f64) -> Self {
         Self {
             added: Vec::new(),
             mass_ratios: vec![1.0],
+            viscosities: vec![nu],
             current: 0,
         }
     }
-}
 
-impl Materials {
     /// Number of materials, the world's own fluid included.
     pub fn len(&self) -> usize {
         self.added.len() + 1
@@ -95,6 +123,7 @@ impl Materials {
         match id {
             0 => Some(Material {
                 rest_density: reference,
+                kinematic_viscosity: self.viscosities[0],
             }),
             _ => self.added.get(id as usize - 1).copied(),
         }
@@ -113,7 +142,25 @@ impl Materials {
         }
         self.added.push(material);
         self.mass_ratios.push(material.rest_density / reference);
+        self.viscosities.push(material.kinematic_viscosity);
         Ok((self.len() - 1) as MaterialId)
+    }
+
+    /// Sets material `id`'s kinematic viscosity to `nu` (m²/s). Errors, changing nothing, on
+    /// an id the world has no material for or a viscosity [`check_viscosity`] rejects.
+    pub fn set_viscosity(&mut self, id: MaterialId, nu: f64) -> Result<(), Error> {
+        self.check_id("material", id)?;
+        check_viscosity(nu)?;
+        self.viscosities[id as usize] = nu;
+        if let Some(m) = (id as usize).checked_sub(1) {
+            self.added[m].kinematic_viscosity = nu;
+        }
+        Ok(())
+    }
+
+    /// Whether any material has a physical viscosity.
+    pub fn viscous(&self) -> bool {
+        self.viscosities.iter().any(|&nu| nu > 0.0)
     }
 
     /// Errors, naming `field`, where `id` is not one of the materials.

@@ -260,7 +260,9 @@ pub struct Params {
     pub viscosity: f64,
     /// Kinematic viscosity ν (m²/s) of the implicit viscosity solve (docs/method.md §13):
     /// 0, the default, leaves it out; water is 1e-6, olive oil about 1e-4, honey 1e-2 and
-    /// more. Stable at every value and step size.
+    /// more. Stable at every value and step size. It is the world's own fluid's (material 0),
+    /// which [`crate::World::set_material_kinematic_viscosity`] may change later; other
+    /// materials have their own ([`crate::Material::kinematic_viscosity`]).
     pub kinematic_viscosity: f64,
     /// Vorticity confinement coefficient ε (dimensionless, docs/method.md §15): 0, the
     /// default, leaves it out; 0.1–1 gives back rotation that the iteration and XSPH damp.

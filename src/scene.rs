@@ -190,11 +190,8 @@ impl Scene {
         }
         self.add_bodies(world)?;
         for (i, m) in self.materials.iter().enumerate() {
-            let material = crate::Material {
-                rest_density: m.rest_density,
-            };
             world
-                .add_material(material)
+                .add_material(m.material())
                 .map_err(|e| prefixed(e, &format!("materials[{i}]: ")))?;
         }
         for (i, b) in self.fluid_blocks.iter().enumerate() {

@@ -543,10 +543,11 @@ impl Fuzzer {
                 }
                 22 => {
                     // Materials: add one (ordinary and bad densities), choose one (known or
-                    // not), or read them back, per material and per particle (short buffers).
+                    // not), set a viscosity (ordinary or bad), or read them back, per
+                    // material and per particle (short buffers).
                     let range = self.rng.pick(&[1usize, 2, 3, 8, 300]);
                     let material = self.rng.below(range) as u16;
-                    match self.rng.below(4) {
+                    match self.rng.below(5) {
                         0 => {
                             let rho = double(&mut self.rng, &[800.0, 1000.0, 1500.0, 3000.0]);
                             let mut id = u16::MAX;
@@ -580,6 +581,23 @@ impl Fuzzer {
                                 _ => assert_eq!(rho, -7.0, "get_material_rest_density wrote"),
                             }
                             ("get_material_rest_density", status, Moves::Nothing, 0)
+                        }
+                        3 => {
+                            let nu = double(&mut self.rng, &[0.0, 1e-4, 1e-2]);
+                            let status = pf_world_set_material_kinematic_viscosity(w, material, nu);
+                            let mut read = -7.0;
+                            let back =
+                                pf_world_get_material_kinematic_viscosity(w, material, &mut read);
+                            if status == PfStatus::PF_OK {
+                                assert_eq!(back, PfStatus::PF_OK);
+                                assert_eq!(read, nu, "viscosity read back");
+                            }
+                            (
+                                "set_material_kinematic_viscosity",
+                                status,
+                                Moves::Nothing,
+                                0,
+                            )
                         }
                         _ => {
                             let valid = |m: u16| m < 0xabcd;

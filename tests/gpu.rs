@@ -275,9 +275,7 @@ fn unsupported_worlds_are_refused_naming_the_feature() {
     world.step().expect("a step on the GPU");
     let mut world = World::new(Params::default()).expect("parameters");
     let oil = world
-        .add_material(Material {
-            rest_density: 800.0,
-        })
+        .add_material(Material::with_density(800.0))
         .expect("a material");
     world.set_fluid_material(oil).expect("the material");
     world
@@ -285,6 +283,22 @@ fn unsupported_worlds_are_refused_naming_the_feature() {
         .expect("fluid");
     let mut world = on_gpu(world);
     world.step().expect("a step on the GPU");
+    // A material's viscosity is refused on the GPU as the parameter's is, changing nothing.
+    let message = world
+        .set_material_kinematic_viscosity(oil, 1e-3)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("backend") && message.contains("kinematic_viscosity"),
+        "{message}"
+    );
+    assert_eq!(world.material(oil).unwrap().kinematic_viscosity, 0.0);
+    let honey = Material {
+        rest_density: 1420.0,
+        kinematic_viscosity: 0.1,
+    };
+    assert!(world.add_material(honey).is_err());
+    assert_eq!(world.material_count(), 2);
 }
 
 /// Set for the run of [`missing_adapter_probe`] that
@@ -425,9 +439,7 @@ fn a_world_made_on_the_gpu_steps_as_one_switched_there() {
     // A material is added to a world on the device as on the CPU, and the world steps on
     // there with its constants made again.
     let oil = made
-        .add_material(Material {
-            rest_density: 800.0,
-        })
+        .add_material(Material::with_density(800.0))
         .expect("materials run on the GPU");
     assert_eq!(made.material(oil).map(|m| m.rest_density), Some(800.0));
     made.step()
@@ -747,7 +759,7 @@ fn blob_world(blob: f64) -> World {
     }
     world.add_fluid_particles(&water, None).expect("water");
     let material = world
-        .add_material(Material { rest_density: blob })
+        .add_material(Material::with_density(blob))
         .expect("a material");
     world.set_fluid_material(material).expect("the material");
     world.add_fluid_particles(&heavy, None).expect("the blob");

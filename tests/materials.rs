@@ -61,7 +61,7 @@ fn blob_world(blob: f64, threads: usize) -> World {
         middle(i) && middle(k) && (10..14).contains(&j)
     });
     world.add_fluid_particles(&water, None).unwrap();
-    let material = world.add_material(Material { rest_density: blob }).unwrap();
+    let material = world.add_material(Material::with_density(blob)).unwrap();
     world.set_fluid_material(material).unwrap();
     world.add_fluid_particles(&heavy, None).unwrap();
     world
@@ -148,7 +148,7 @@ fn bad_materials_are_refused_and_change_nothing() {
     let mut world = World::new(Params::default()).unwrap();
     for bad in [f64::NAN, f64::INFINITY, 0.0, -1000.0, 50.0, 20_000.0] {
         let e = world
-            .add_material(Material { rest_density: bad })
+            .add_material(Material::with_density(bad))
             .unwrap_err()
             .to_string();
         assert!(e.contains("rest_density"), "{e}");
@@ -157,18 +157,9 @@ fn bad_materials_are_refused_and_change_nothing() {
     let e = world.set_fluid_material(1).unwrap_err().to_string();
     assert!(e.contains("material") && e.contains("0 to 0"), "{e}");
     assert_eq!(world.fluid_material(), 0);
-    let oil = world
-        .add_material(Material {
-            rest_density: 800.0,
-        })
-        .unwrap();
+    let oil = world.add_material(Material::with_density(800.0)).unwrap();
     assert_eq!((oil, world.material_count()), (1, 2));
-    assert_eq!(
-        world.material(1),
-        Some(Material {
-            rest_density: 800.0
-        })
-    );
+    assert_eq!(world.material(1), Some(Material::with_density(800.0)));
     assert_eq!(world.material(2), None);
     world
         .add_fluid_block(Vec3::repeat(0.1), [2, 2, 2], Vec3::zeros())
@@ -188,12 +179,7 @@ fn bad_materials_are_refused_and_change_nothing() {
 fn oil_spreads_over_water_in_the_builtin_scene() {
     let scene = projfluid::scene::Scene::builtin("oil_on_water").unwrap();
     let mut world = scene.build_world().unwrap();
-    assert_eq!(
-        world.material(1),
-        Some(Material {
-            rest_density: 800.0
-        })
-    );
+    assert_eq!(world.material(1), Some(Material::with_density(800.0)));
     world.advance(1.0).unwrap();
     let (mut oil, mut water) = (0.0, 0.0);
     for _ in 0..8 {

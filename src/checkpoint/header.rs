@@ -40,6 +40,11 @@ pub(super) struct Header {
     /// in the order they were added, and the material of the fluid added next.
     pub materials: Vec<f64>,
     pub fluid_material: u16,
+    /// Every material's kinematic viscosity ν (m²/s), the world's own fluid's first; absent
+    /// in checkpoints written before materials had their own viscosity, whose materials had
+    /// none beyond the parameters' (`kinematic_viscosity`) for the world's own fluid.
+    #[serde(default)]
+    pub viscosities: Vec<f64>,
 }
 
 /// A box as its lower and upper corners (m).

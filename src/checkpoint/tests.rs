@@ -136,9 +136,9 @@ fn a_resumed_world_keeps_its_physical_viscosity() {
     assert!(resumed.velocities() == reference.velocities());
 }
 
-/// Every particle's material and the world's materials travel with the checkpoint: a
-/// resumed world of two liquids continues bit for bit; one whose particles all forgot their
-/// material does not.
+/// Every particle's material and the world's materials, their viscosities too, travel with
+/// the checkpoint: a resumed world of two liquids continues bit for bit; one whose particles
+/// all forgot their material does not.
 #[test]
 fn a_resumed_world_keeps_its_materials() {
     let scene = small_scene();
@@ -146,8 +146,10 @@ fn a_resumed_world_keeps_its_materials() {
     let heavy = reference
         .add_material(crate::Material {
             rest_density: 2500.0,
+            kinematic_viscosity: 0.05,
         })
         .unwrap();
+    reference.set_material_kinematic_viscosity(0, 1e-3).unwrap();
     reference.set_fluid_material(heavy).unwrap();
     reference
         .add_fluid_block(Vec3::new(0.05, 0.5, 0.05), [3, 3, 3], Vec3::zeros())
@@ -161,6 +163,7 @@ fn a_resumed_world_keeps_its_materials() {
     std::fs::remove_file(&path).unwrap();
     assert_eq!(resumed.material_count(), 2);
     assert_eq!(resumed.material(heavy), reference.material(heavy));
+    assert_eq!(resumed.material(0), reference.material(0));
     assert_eq!(resumed.fluid_material(), heavy);
     assert_eq!(resumed.particle_materials(), reference.particle_materials());
     resumed_matches_and_forgetful_does_not("materials", &scene, reference, 10, |w| {

@@ -6,9 +6,11 @@
 //! which conserves linear and angular momentum. Multiplied by each particle's volume V_i the
 //! system is symmetric and positive definite; conjugate gradients with the 3×3 block-diagonal
 //! preconditioner solve it without forming the matrix. With no-slip walls, boundary particles
-//! of the container, the static obstacles and the static bodies enter the sum at rest.
+//! of the container, the static obstacles and the static bodies enter the sum at rest. Each
+//! particle has its material's ν; a pair takes the harmonic mean of its two (§14).
 
 use super::{Forcing, NonPressureForce};
+use crate::material::MaterialId;
 use crate::reserve::reserve_total;
 use crate::{Vec3, reduce};
 use nalgebra::Matrix3;
@@ -31,11 +33,10 @@ const MOST_CALIBRATION: f64 = 3.0;
 /// The most conjugate-gradient iterations of one solve.
 const MAX_ITERATIONS: usize = 200;
 
-/// The implicit viscosity solve with kinematic viscosity ν (m²/s) and its buffers.
+/// The implicit viscosity solve, each particle of its material's kinematic viscosity, and
+/// its buffers.
 #[derive(Clone, Debug)]
 pub(crate) struct Viscosity {
-    /// ν (m²/s).
-    nu: f64,
     /// Whether walls enter the Laplacian at rest (no slip) or not at all (free slip).
     no_slip: bool,
     /// V_i = m/ρ_i (m³).
@@ -51,10 +52,9 @@ pub(crate) struct Viscosity {
 }
 
 impl Viscosity {
-    /// The solve for kinematic viscosity `nu` (m²/s, > 0), with no-slip walls if `no_slip`.
-    pub fn new(nu: f64, no_slip: bool) -> Self {
+    /// The solve, with no-slip walls if `no_slip`.
+    pub fn new(no_slip: bool) -> Self {
         Self {
-            nu,
             no_slip,
             volumes: Vec::new(),
             calibration: Vec::new(),
@@ -67,11 +67,13 @@ impl Viscosity {
     }
 }
 
-/// What the operator reads: positions (m), volumes (m³), the calibration, and the coupling
-/// c = 2(d+2)·Δt·ν (m²) with the regularisation ε = 0.01 H² (m²).
+/// What the operator reads: positions (m), materials, volumes (m³), the calibration, and the
+/// coupling c = 2(d+2)·Δt (s), which a pair's viscosity ν_ij multiplies, with the
+/// regularisation ε = 0.01 H² (m²).
 struct Operator<'a> {
     f: &'a Forcing<'a>,
     x: &'a [Vec3],
+    materials: &'a [MaterialId],
     volumes: &'a [f64],
     /// κ_i, or empty while it is being measured (then 1).
     calibration: &'a [f64],
@@ -88,6 +90,30 @@ impl Operator<'_> {
         let len2 = r.norm_squared();
         let c = self.f.constraint.kernel.grad_w_coefficient(len2.sqrt());
         -c / (len2 + self.epsilon)
+    }
+
+    /// Particle i's kinematic viscosity ν_i (m²/s), its material's.
+    #[inline]
+    fn nu(&self, i: usize) -> f64 {
+        self.f.viscosities[self.materials[i] as usize]
+    }
+
+    /// The viscosity ν_ij (m²/s) of the pair of `i` and fluid neighbour `j`, or of `i` and a
+    /// wall (`None`): the harmonic mean 2ν_iν_j/(ν_i + ν_j) of two materials, as the flux
+    /// between layers of different conductivity is, so that shear stress is continuous across
+    /// an interface and a liquid without viscosity drags on none; ν_i towards a wall.
+    #[inline]
+    fn pair_nu(&self, i: usize, j: Option<usize>) -> f64 {
+        let a = self.nu(i);
+        let Some(j) = j else { return a };
+        let b = self.nu(j);
+        if a == b {
+            a
+        } else if a + b > 0.0 {
+            2.0 * a * b / (a + b)
+        } else {
+            0.0
+        }
     }
 
     /// κ_i, 1 while it is being measured.
@@ -143,21 +169,23 @@ impl Operator<'_> {
         }
     }
 
-    /// (A v)_i = V_i v_i + c V_i Σ_j V_j g_ij r (r·(v_i − v_j)), a wall's v_j being 0.
+    /// (A v)_i = V_i v_i + c V_i Σ_j ν_ij V_j g_ij r (r·(v_i − v_j)), a wall's v_j being 0.
     fn apply(&self, v: &[Vec3], i: usize) -> Vec3 {
         let mut sum = Vec3::zeros();
         let vi = v[i];
         self.for_pairs(i, |g, r, j| {
             let relative = j.map_or(vi, |j| vi - v[j]);
-            sum += r * (g * r.dot(&relative));
+            sum += r * (g * self.pair_nu(i, j) * r.dot(&relative));
         });
         self.volumes[i] * (vi + sum * self.coupling)
     }
 
-    /// The inverse of particle `i`'s diagonal block V_i (I + c Σ g r rᵀ).
+    /// The inverse of particle `i`'s diagonal block V_i (I + c Σ ν_ij g r rᵀ).
     fn block_inverse(&self, i: usize) -> Matrix3<f64> {
         let mut sum = Matrix3::zeros();
-        self.for_pairs(i, |g, r, _| sum += r * r.transpose() * g);
+        self.for_pairs(i, |g, r, j| {
+            sum += r * r.transpose() * (g * self.pair_nu(i, j))
+        });
         let block = (Matrix3::identity() + sum * self.coupling) * self.volumes[i];
         block
             .try_inverse()
@@ -191,9 +219,10 @@ impl NonPressureForce for Viscosity {
         let mut op = Operator {
             f,
             x: &fluid.positions,
+            materials: &fluid.materials,
             volumes: &self.volumes,
             calibration: &[],
-            coupling: LAPLACIAN_FACTOR * f.dt * self.nu,
+            coupling: LAPLACIAN_FACTOR * f.dt,
             epsilon: REGULARISATION * h * h,
             no_slip: self.no_slip,
         };

@@ -63,13 +63,7 @@ impl Params {
                 "must lie in [0, 1]",
             ));
         }
-        if !(self.kinematic_viscosity.is_finite() && self.kinematic_viscosity >= 0.0) {
-            return Err(Error::invalid(
-                "kinematic_viscosity",
-                self.kinematic_viscosity,
-                "must be finite and not negative (m²/s; 0 turns it off)",
-            ));
-        }
+        crate::material::check_viscosity(self.kinematic_viscosity)?;
         if !(self.vorticity_confinement.is_finite()
             && (0.0..=MAX_VORTICITY_CONFINEMENT).contains(&self.vorticity_confinement))
         {

@@ -60,6 +60,7 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
             scene.materials.push(SceneMaterial {
                 name: "oil".into(),
                 rest_density: 800.0,
+                kinematic_viscosity: None,
             });
             scene.fluid_blocks.push(FluidBlock {
                 material: Some("oil".into()),

@@ -67,6 +67,20 @@ pub struct SceneMaterial {
     pub name: String,
     /// Rest density ρ0 (kg/m³), between a tenth and ten times the scene's `rest_density`.
     pub rest_density: f64,
+    /// Kinematic viscosity ν (m²/s) of the implicit viscosity solve; absent or 0 leaves the
+    /// liquid without physical viscosity (docs/method.md §13).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kinematic_viscosity: Option<f64>,
+}
+
+impl SceneMaterial {
+    /// The material this entry describes.
+    pub fn material(&self) -> crate::Material {
+        crate::Material {
+            rest_density: self.rest_density,
+            kinematic_viscosity: self.kinematic_viscosity.unwrap_or(0.0),
+        }
+    }
 }
 
 impl FluidBlock {

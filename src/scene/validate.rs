@@ -119,10 +119,7 @@ fn check_materials(scene: &Scene) -> Result<(), Error> {
                 "must be a name no other material has",
             ));
         }
-        let material = crate::Material {
-            rest_density: m.rest_density,
-        };
-        material
+        m.material()
             .check(scene.params.rest_density)
             .map_err(|e| super::prefixed(e, &format!("materials[{i}].")))?;
     }
@@ -422,6 +419,12 @@ mod tests {
         assert_eq!(good.materials[0].rest_density, 800.0);
         let world = good.build_world().unwrap();
         assert_eq!(world.material_count(), 2);
+        assert_eq!(world.material(1).unwrap().kinematic_viscosity, 0.0);
+        let honey = r#"[{"name": "oil", "rest_density": 1420, "kinematic_viscosity": 0.1}]"#;
+        let viscous = Scene::from_json(&scene(honey, r#", "material": "oil""#)).unwrap();
+        let built = viscous.build_world().unwrap();
+        assert_eq!(built.material(1).unwrap().kinematic_viscosity, 0.1);
+        assert_eq!(Scene::from_json(&viscous.to_json()).unwrap(), viscous);
         assert_eq!(world.particle_materials(), [[0; 8], [1; 8]].concat());
         assert_eq!(world.fluid_material(), 0);
         assert_eq!(Scene::from_json(&good.to_json()).unwrap(), good);
@@ -435,6 +438,11 @@ mod tests {
                 r#"[{"name": "oil", "rest_density": 5}]"#.into(),
                 "",
                 vec!["materials[0].rest_density", "5"],
+            ),
+            (
+                r#"[{"name": "oil", "rest_density": 800, "kinematic_viscosity": -1}]"#.into(),
+                "",
+                vec!["materials[0].kinematic_viscosity", "-1"],
             ),
             (
                 r#"[{"name": "", "rest_density": 800}]"#.into(),

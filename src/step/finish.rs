@@ -18,6 +18,8 @@ pub(super) struct Finish<'a> {
     pub constraint: &'a DensityConstraint,
     pub boundary: &'a Boundary,
     pub forces: &'a mut [Box<dyn NonPressureForce>],
+    /// Each material's kinematic viscosity ν (m²/s).
+    pub viscosities: &'a [f64],
     /// Step size (s).
     pub dt: f64,
 }
@@ -35,6 +37,7 @@ pub(super) fn finish(
         constraint,
         boundary,
         forces,
+        viscosities,
         dt,
     } = f;
     let t = Instant::now();
@@ -67,6 +70,7 @@ pub(super) fn finish(
         constraint,
         nb: &nb,
         boundary,
+        viscosities,
         dt,
     };
     for force in forces.iter_mut() {

@@ -26,6 +26,7 @@ use crate::boundary::{Aabb, Boundary};
 use crate::constraint::{Corrections, DensityConstraint, Projection};
 use crate::fluid::Fluid;
 use crate::forces::NonPressureForce;
+use crate::material::Materials;
 use crate::neighbors::{CellTable, NeighborLists};
 use crate::params::Params;
 use crate::solver::{Chebyshev, DiagonalSystem, GlobalSolver};
@@ -95,8 +96,8 @@ pub(crate) struct StepContext<'a> {
     pub containers: &'a [Aabb],
     /// The fluid's load on the walls and static obstacles (written).
     pub wall_load: &'a mut Load,
-    /// Each material's mass over the world's particle mass, ρ0_i/ρ0 (docs/method.md §14).
-    pub mass_ratios: &'a [f64],
+    /// The fluid's materials: their mass ratios and viscosities (docs/method.md §14).
+    pub materials: &'a Materials,
     /// Simulated time at the start of the step (s).
     pub time: f64,
     /// The fastest emitter still emitting after the step (m/s; 0 without any), which the
@@ -126,7 +127,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
         bodies,
         containers,
         wall_load,
-        mass_ratios,
+        materials,
         time,
         inflow_speed,
     } = ctx;
@@ -146,7 +147,12 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             boundary.place_moving(grid, moving_particles(bodies))?;
         }
         search::search(grid, boundary, params.support_radius(), buffers)?;
-        slot_masses(constraint.mass, mass_ratios, &fluid.materials, buffers)?;
+        slot_masses(
+            constraint.mass,
+            &materials.mass_ratios,
+            &fluid.materials,
+            buffers,
+        )?;
         reserve_scratch(pool, buffers)?;
         timings.neighbors = started.elapsed().as_secs_f64();
         if couple {
@@ -219,6 +225,7 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 constraint,
                 boundary,
                 forces,
+                viscosities: &materials.viscosities,
                 dt,
             },
             fluid,

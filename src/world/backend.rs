@@ -150,7 +150,7 @@ impl World {
         if !self.boundary.walls.is_empty() {
             return refuse("container walls built as fields");
         }
-        if self.params.kinematic_viscosity > 0.0 {
+        if self.materials.viscous() {
             return refuse("the physical viscosity (kinematic_viscosity)");
         }
         Ok(())

@@ -3,6 +3,7 @@
 
 use super::World;
 use crate::Error;
+use crate::forces;
 use crate::material::{Material, MaterialId};
 
 impl World {
@@ -11,8 +12,43 @@ impl World {
     /// [`World::set_fluid_material`] chooses it. Errors, changing nothing, on a rest density
     /// that is not finite or lies outside [`crate::material::DENSITY_RATIO_RANGE`] times the
     /// world's, or on more than [`crate::material::MAX_MATERIALS`] materials.
+    ///
+    /// A material with a kinematic viscosity brings the implicit viscosity solve into the
+    /// step (docs/method.md §13), which the GPU backend refuses.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
-        self.materials.add(material, self.params.rest_density)
+        if material.kinematic_viscosity > 0.0 {
+            self.refuse_on_gpu("the physical viscosity (kinematic_viscosity)")?;
+        }
+        let id = self.materials.add(material, self.params.rest_density)?;
+        self.update_forces();
+        Ok(id)
+    }
+
+    /// Sets the kinematic viscosity ν (m²/s) of material `id` (0 is the world's own fluid,
+    /// whose [`crate::Params::kinematic_viscosity`] follows), from the next step on. Errors,
+    /// changing nothing, on an id the world has no material for, a viscosity that is negative
+    /// or not finite, or a viscosity on a world that steps on the GPU.
+    pub fn set_material_kinematic_viscosity(
+        &mut self,
+        id: MaterialId,
+        nu: f64,
+    ) -> Result<(), Error> {
+        if nu > 0.0 {
+            self.refuse_on_gpu("the physical viscosity (kinematic_viscosity)")?;
+        }
+        self.materials.set_viscosity(id, nu)?;
+        if id == 0 {
+            self.params.kinematic_viscosity = nu;
+        }
+        self.update_forces();
+        Ok(())
+    }
+
+    /// Makes the non-pressure forces again, as the materials now ask for them (the
+    /// viscosity solve where any has a viscosity); their buffers are reserved before the
+    /// next step.
+    fn update_forces(&mut self) {
+        self.forces = forces::of_world(&self.params, &self.materials);
     }
 
     /// Chooses the material of the fluid added from now on: by [`World::add_fluid_block`],

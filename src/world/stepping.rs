@@ -159,7 +159,7 @@ impl World {
             bodies,
             containers,
             wall_load,
-            mass_ratios: &materials.mass_ratios,
+            materials,
             time: *time,
             inflow_speed,
         };

@@ -68,6 +68,13 @@ static void two_liquids(const PfParams *params, int steps) {
     CHECK(rho0 == params->rest_density);
     OK(pf_world_fluid_material(world, &current));
     CHECK(current == 0); /* adding a material does not choose it */
+    /* Materials start without physical viscosity; one is set and read back. */
+    double nu = -1.0;
+    OK(pf_world_get_material_kinematic_viscosity(world, heavy, &nu));
+    CHECK(nu == 0.0);
+    OK(pf_world_set_material_kinematic_viscosity(world, heavy, 1e-3));
+    OK(pf_world_get_material_kinematic_viscosity(world, heavy, &nu));
+    CHECK(nu == 1e-3);
 
     /* A 6 x 5 x 6 lattice one spacing and r/4 from the walls: its two bottom layers heavy,
      * the three above them water (material 0), added as particles (not settled, so the

@@ -384,6 +384,10 @@ int main(void) {
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_material(NULL, &material));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_material_count(NULL, &count));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_rest_density(NULL, 0, &rho0));
+        REJECT(w, PF_ERROR_NULL_POINTER,
+               pf_world_set_material_kinematic_viscosity(NULL, 0, 1e-3));
+        REJECT(w, PF_ERROR_NULL_POINTER,
+               pf_world_get_material_kinematic_viscosity(NULL, 0, &rho0));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(NULL, mats, 27, &needed));
         CHECK(strstr(last_msg, "world must not be NULL") != NULL);
         /* NULL outputs: a material is not added for want of a place to put its id. */
@@ -392,6 +396,7 @@ int main(void) {
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_fluid_material(w, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_material_count(w, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_rest_density(w, 0, NULL));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_kinematic_viscosity(w, 0, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(w, NULL, 27, NULL));
         CHECK(strstr(last_msg, "out must not be NULL") != NULL);
         /* Rest densities that are not finite or lie outside 0.1 to 10 times the world's
@@ -413,6 +418,18 @@ int main(void) {
                                "got 2") != NULL);
         REJECT(w, PF_ERROR_INVALID_ARGUMENT,
                pf_world_get_material_rest_density(w, UINT16_MAX, &rho0));
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+               pf_world_get_material_kinematic_viscosity(w, 2, &rho0));
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+               pf_world_set_material_kinematic_viscosity(w, 2, 1e-3));
+        /* Viscosities that are negative or not finite, the argument named. */
+        const double bad_viscosities[] = {NAN, INFINITY, -1e-3};
+        for (size_t i = 0; i < sizeof bad_viscosities / sizeof *bad_viscosities; i++) {
+            REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+                   pf_world_set_material_kinematic_viscosity(w, 1, bad_viscosities[i]));
+            CHECK(strstr(last_msg, "pf_world_set_material_kinematic_viscosity: "
+                                   "kinematic_viscosity must be finite") != NULL);
+        }
         /* A short buffer: the size needed is reported and the buffer is left untouched. */
         for (size_t i = 0; i < sizeof mats / sizeof *mats; i++) mats[i] = 0xabcd;
         needed = 0;

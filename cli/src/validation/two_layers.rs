@@ -205,9 +205,7 @@ fn tank(
         }
     }
     world.add_fluid_particles(&water, None)?;
-    let material = world.add_material(Material {
-        rest_density: setup.light_density,
-    })?;
+    let material = world.add_material(Material::with_density(setup.light_density))?;
     world.set_fluid_material(material)?;
     world.add_fluid_particles(&lighter, None)?;
     Ok((world, tank, material, gap))

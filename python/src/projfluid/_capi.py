@@ -184,6 +184,8 @@ SIGNATURES: dict[str, tuple[list[Any], Any]] = {
     "pf_world_fluid_material": ([_world, _u16s], _status),
     "pf_world_material_count": ([_world, _sizes], _status),
     "pf_world_get_material_rest_density": ([_world, c_uint16, _doubles], _status),
+    "pf_world_set_material_kinematic_viscosity": ([_world, c_uint16, c_double], _status),
+    "pf_world_get_material_kinematic_viscosity": ([_world, c_uint16, _doubles], _status),
     "pf_world_get_materials": ([_world, _u16s, c_size_t, _sizes], _status),
     # stepping
     "pf_world_step": ([_world, c_double], _status),

@@ -260,6 +260,28 @@ class World(BodiesMixin, FlowMixin):
         self._call(lib.pf_world_get_material_rest_density, _material_id(material), byref(out))
         return out.value
 
+    def set_material_kinematic_viscosity(self, material: int, kinematic_viscosity: float) -> None:
+        """Sets the kinematic viscosity ν (m²/s) of ``material`` from the next step on: 0
+        leaves it without physical viscosity, water is 1e-6, honey 1e-2 and more. Material 0
+        is the world's own fluid (its ``Params.kinematic_viscosity`` so far); the others
+        start without one. An unknown id, a negative or non-finite ν, or a ν above 0 in a
+        world on the GPU raises :class:`~projfluid.errors.InvalidArgumentError` and changes
+        nothing."""
+        self._call(
+            lib.pf_world_set_material_kinematic_viscosity,
+            _material_id(material),
+            float(kinematic_viscosity),
+        )
+
+    def material_kinematic_viscosity(self, material: int) -> float:
+        """The kinematic viscosity ν (m²/s) of ``material``. An id the world does not have
+        raises :class:`~projfluid.errors.InvalidArgumentError`."""
+        out = c_double()
+        self._call(
+            lib.pf_world_get_material_kinematic_viscosity, _material_id(material), byref(out)
+        )
+        return out.value
+
     def materials(self, out: np.ndarray | None = None) -> np.ndarray:
         """Every fluid particle's material id as an (n,) uint16 array, in ascending id
         order like :meth:`positions`; ``out`` as in :meth:`positions`."""

@@ -47,7 +47,7 @@ pub unsafe extern "C" fn pf_world_add_material(
         let mut world = args.world(world)?;
         // Checked before the material is added, so that a bad `out` adds nothing.
         let out = args.out_slice(out, 1, "out")?;
-        out[0] = world.add_material(Material { rest_density })?;
+        out[0] = world.add_material(Material::with_density(rest_density))?;
         Ok(())
     })
 }
@@ -109,6 +109,29 @@ pub unsafe extern "C" fn pf_world_material_count(
     })
 }
 
+/// Writes `property` of `material` into `*out` for the function `name`: the shared body of
+/// the per-material reads.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+unsafe fn read_material(
+    name: &'static str,
+    world: *const PfWorld,
+    material: u16,
+    out: *mut f64,
+    property: fn(&Material) -> f64,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call(name, || {
+        let world = args.world(world)?;
+        let found = world
+            .material(material)
+            .ok_or_else(|| unknown_material(material, world.material_count()))?;
+        args.write(out, property(&found), "out")
+    })
+}
+
 /// Stores in `*out` the rest density (kg/m³) of `material`: `PfParams.rest_density` for
 /// material 0, and for the others the value `pf_world_add_material` was given.
 ///
@@ -124,15 +147,58 @@ pub unsafe extern "C" fn pf_world_get_material_rest_density(
     material: u16,
     out: *mut f64,
 ) -> PfStatus {
+    let name = "pf_world_get_material_rest_density";
+    // SAFETY: the caller keeps the contract above, which is read_material's.
+    unsafe { read_material(name, world, material, out, |m| m.rest_density) }
+}
+
+/// Sets the kinematic viscosity ν (m²/s) of `material` from the next step on: 0 leaves it
+/// without physical viscosity, water is 1e-6, honey 1e-2 and more (docs/method.md §13).
+/// Material 0 is the world's own fluid, whose `PfParams.kinematic_viscosity` was its
+/// viscosity so far; other materials start without one. Where two materials meet, the
+/// solve couples them with the harmonic mean of their viscosities.
+///
+/// Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
+/// the world does not have, the message giving the valid range; a viscosity that is
+/// negative or not finite; a viscosity above 0 in a world that steps on the GPU, which does
+/// not run the viscosity solve, the message starting "backend gpu"). On any error nothing
+/// changes. Thread safety: one thread at a time per world.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_set_material_kinematic_viscosity(
+    world: *mut PfWorld,
+    material: u16,
+    kinematic_viscosity: f64,
+) -> PfStatus {
     // SAFETY: the caller keeps the contract above.
     let args = unsafe { Args::trusted() };
-    status_call("pf_world_get_material_rest_density", || {
-        let world = args.world(world)?;
-        let found = world
-            .material(material)
-            .ok_or_else(|| unknown_material(material, world.material_count()))?;
-        args.write(out, found.rest_density, "out")
+    status_call("pf_world_set_material_kinematic_viscosity", || {
+        let mut world = args.world(world)?;
+        Ok(world.set_material_kinematic_viscosity(material, kinematic_viscosity)?)
     })
+}
+
+/// Stores in `*out` the kinematic viscosity ν (m²/s) of `material`: for material 0
+/// `PfParams.kinematic_viscosity` until `pf_world_set_material_kinematic_viscosity` sets
+/// it, for the others 0 until it does.
+///
+/// Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+/// material the world does not have, the message giving the valid range); `*out` is then
+/// untouched.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_get_material_kinematic_viscosity(
+    world: *const PfWorld,
+    material: u16,
+    out: *mut f64,
+) -> PfStatus {
+    let name = "pf_world_get_material_kinematic_viscosity";
+    // SAFETY: the caller keeps the contract above, which is read_material's.
+    unsafe { read_material(name, world, material, out, |m| m.kinematic_viscosity) }
 }
 
 /// Copies every fluid particle's material id into `out`, in ascending id order, the order
@@ -292,5 +358,46 @@ mod tests {
             assert_eq!(rho, 1500.0);
             pf_world_destroy(world);
         }
+    }
+
+    /// A material's viscosity is set and read back; bad ones and bad ids change nothing.
+    #[test]
+    fn material_viscosities_are_set_read_and_checked() {
+        let world = two_liquids();
+        let mut nu = -1.0f64;
+        let set = |material: u16, nu: f64| {
+            // SAFETY: a live world.
+            unsafe { pf_world_set_material_kinematic_viscosity(world, material, nu) }
+        };
+        let get = |material: u16, out: *mut f64| {
+            // SAFETY: a live world; `out` is NULL or points to an f64.
+            unsafe { pf_world_get_material_kinematic_viscosity(world, material, out) }
+        };
+        assert_eq!(get(1, &mut nu), PfStatus::PF_OK);
+        assert_eq!(nu, 0.0);
+        assert_eq!(set(1, 0.05), PfStatus::PF_OK);
+        for bad in [f64::NAN, -1.0, f64::INFINITY] {
+            assert_eq!(set(1, bad), PfStatus::PF_ERROR_INVALID_ARGUMENT, "{bad}");
+            assert!(
+                message()
+                    .starts_with("pf_world_set_material_kinematic_viscosity: kinematic_viscosity"),
+                "{}",
+                message()
+            );
+        }
+        assert_eq!(set(5, 0.1), PfStatus::PF_ERROR_INVALID_ARGUMENT);
+        assert!(message().contains("material"), "{}", message());
+        assert_eq!(get(1, &mut nu), PfStatus::PF_OK);
+        assert_eq!(nu, 0.05);
+        assert_eq!(get(0, &mut nu), PfStatus::PF_OK);
+        assert_eq!(nu, 0.0);
+        assert_eq!(get(1, null_mut()), PfStatus::PF_ERROR_NULL_POINTER);
+        assert_eq!(get(3, &mut nu), PfStatus::PF_ERROR_INVALID_ARGUMENT);
+        assert_eq!(nu, 0.0);
+        // SAFETY: NULL is refused before anything is read.
+        let status = unsafe { pf_world_set_material_kinematic_viscosity(null_mut(), 0, 0.1) };
+        assert_eq!(status, PfStatus::PF_ERROR_NULL_POINTER);
+        // SAFETY: destroyed once, not used afterwards.
+        unsafe { pf_world_destroy(world) };
     }
 }

@@ -39,3 +39,20 @@ pub struct StepStats {
     /// Where the time went.
     pub timings: StepTimings,
 }
+
+impl StepStats {
+    /// A step of `dt` seconds (s) without fluid to move: no iteration, no error.
+    pub(crate) fn idle(dt: f64) -> Self {
+        Self {
+            dt,
+            outer_iterations: 0,
+            inner_iterations: 0,
+            hit_max_iterations: false,
+            rho: 0.0,
+            last_displacement: 0.0,
+            density_error_avg: 0.0,
+            density_error_max: 0.0,
+            timings: StepTimings::default(),
+        }
+    }
+}

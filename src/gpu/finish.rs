@@ -113,14 +113,8 @@ impl Finish {
     }
 }
 
-/// The CFL rule (docs/method.md §8), as on the CPU: Δt = λ·0.4·2r/v_max clamped to
-/// [Δt_min, Δt_max] (s), from `fastest_squared` = max_i |v_i + Δt·g|² (m²/s²).
+/// The CFL rule (docs/method.md §8), as on the CPU ([`crate::step::cfl_step`]), from
+/// `fastest_squared` = max_i |v_i + Δt·g|² (m²/s²): the next step's size (s).
 pub(super) fn next_step_size(params: &Params, fastest_squared: f64) -> f64 {
-    let v_max = fastest_squared.max(1e-9).sqrt();
-    let cfl = params.cfl_factor * 0.4 * params.spacing() / v_max;
-    if cfl.is_finite() {
-        cfl.clamp(params.dt_min, params.dt_max)
-    } else {
-        params.dt_min
-    }
+    crate::step::cfl_step(params, fastest_squared.sqrt())
 }

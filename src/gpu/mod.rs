@@ -9,11 +9,13 @@
 //! by index), sums in a fixed tree, and every per-particle sum gathered by the particle
 //! itself in the order of its neighbour list.
 //!
-//! It steps worlds without bodies, emitters, walls built as fields and the physical
-//! viscosity, with Chebyshev's solver or one Jacobi sweep (without the warm start and the
-//! coarse correction, stepper.rs): the fluid and the static boundary as particles, with
-//! several materials (their mass ratios dividing the projection weights, §14), vorticity
-//! confinement (§15) and XSPH.
+//! It steps worlds without bodies, walls built as fields and the physical viscosity, with
+//! Chebyshev's solver or one Jacobi sweep (without the warm start and the coarse
+//! correction, stepper.rs): the fluid and the static boundary as particles, with several
+//! materials (their mass ratios dividing the projection weights, §14), vorticity
+//! confinement (§15) and XSPH. Emitters, sinks and the domain (§12) act on the host between
+//! steps; where they change the number of particles the stepper is remade on the same
+//! device, its kernels kept.
 //!
 //! One file per stage: [`context`] (device, kernels, read-backs), [`buffers`] (the state on
 //! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists), [`local`]

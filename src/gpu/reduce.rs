@@ -35,15 +35,20 @@ pub(super) struct Reduction {
 }
 
 impl Reduction {
-    /// The passes that reduce the `len` values in `input`.
-    pub fn new(ctx: &Context, len: u32, input: &wgpu::Buffer) -> Self {
+    /// The reduction's kernel, compiled.
+    pub fn compile(ctx: &Context) -> Kernel {
         let slots = [Slot::Uniform, Slot::Storage, Slot::Storage];
-        let kernel = ctx.kernel(
+        ctx.kernel(
             "reduce",
             include_str!("shaders/reduce.wgsl"),
             &slots,
             &["reduce"],
-        );
+        )
+    }
+
+    /// The passes of `kernel` ([`Reduction::compile`]) that reduce the `len` values in
+    /// `input`.
+    pub fn new(ctx: &Context, kernel: Kernel, len: u32, input: &wgpu::Buffer) -> Self {
         let mut passes = Vec::new();
         let mut partials: Vec<wgpu::Buffer> = Vec::new();
         let mut len = len.max(1);
@@ -71,6 +76,11 @@ impl Reduction {
             _partials: partials,
             result,
         }
+    }
+
+    /// The kernel, for a reduction of other values.
+    pub fn into_kernel(self) -> Kernel {
+        self.kernel
     }
 
     /// Records the passes; the value is in [`Reduction::result`] after them.

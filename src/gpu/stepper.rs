@@ -13,7 +13,7 @@
 //! the coarse correction (§3.8); a GPU step always starts from s.
 
 use super::buffers::{Buffers, Grid, IterParams, MATERIAL_SLOTS, StepParams};
-use super::context::{Context, floats, words};
+use super::context::{Context, Kernel, floats, words};
 use super::finish::{Finish, next_step_size};
 use super::global::GlobalStep;
 use super::local::LocalStep;
@@ -66,10 +66,7 @@ pub(crate) struct GpuStepper {
     ctx: Context,
     grid: Grid,
     buffers: Buffers,
-    search: Search,
-    local: LocalStep,
-    global: GlobalStep,
-    finish: Finish,
+    stages: Stages,
     reduction: Reduction,
     params: Params,
     constants: StepParams,
@@ -82,14 +79,46 @@ impl GpuStepper {
     /// Opens the device and uploads `scene`. Errors when there is no usable adapter, or when
     /// the scene has more particles than the device's indices reach.
     pub fn new(scene: Scene) -> Result<Self, Error> {
-        let too_many = |what: &str, count: usize| {
-            Error::invalid(what, count, "must be fewer than 2³² on the GPU backend")
-        };
-        let n = u32::try_from(scene.positions.len())
-            .map_err(|_| too_many("fluid particles", scene.positions.len()))?;
-        u32::try_from(scene.boundary.len())
-            .map_err(|_| too_many("boundary particles", scene.boundary.len()))?;
+        let n = device_count(&scene)?;
         let ctx = Context::new()?;
+        let confine = scene.params.vorticity_confinement > 0.0;
+        let stages = Stages {
+            search: Search::new(&ctx),
+            local: LocalStep::new(&ctx),
+            global: GlobalStep::new(&ctx),
+            finish: Finish::new(&ctx, confine),
+        };
+        let reduce = Reduction::compile(&ctx);
+        let chebyshev = Chebyshev::new(scene.params.chebyshev);
+        Self::assemble(ctx, stages, reduce, chebyshev, n, scene)
+    }
+
+    /// The stepper for `scene`, a world with another number of fluid or boundary particles or
+    /// of materials, on this stepper's device: its kernels are not compiled again, and the
+    /// Chebyshev iteration keeps what it has learnt of ρ. `scene` has the parameters this
+    /// stepper was made with. Errors as [`GpuStepper::new`], when the device fails.
+    pub fn remake(self, scene: Scene) -> Result<Self, Error> {
+        let n = device_count(&scene)?;
+        let GpuStepper {
+            ctx,
+            stages,
+            reduction,
+            chebyshev,
+            ..
+        } = self;
+        Self::assemble(ctx, stages, reduction.into_kernel(), chebyshev, n, scene)
+    }
+
+    /// The stepper of `n` fluid particles from `scene` on `ctx`, with its compiled `stages`
+    /// and reduction kernel `reduce`, and the iteration `chebyshev`; uploads the fluid.
+    fn assemble(
+        ctx: Context,
+        stages: Stages,
+        reduce: Kernel,
+        chebyshev: Chebyshev,
+        n: u32,
+        scene: Scene,
+    ) -> Result<Self, Error> {
         let params = scene.params.clone();
         let h = params.support_radius();
         let bounds = [Aabb::around(scene.positions), Aabb::around(scene.boundary)]
@@ -106,14 +135,11 @@ impl GpuStepper {
         let cells = grid.cells();
         let buffers = Buffers::new(&ctx, n, cells, &boundary, &boundary_start, confine);
         let constants = constants(&params, &grid, scene, boundary.len() as u32);
-        let reduction = Reduction::new(&ctx, n, &buffers.values);
+        let reduction = Reduction::new(&ctx, reduce, n, &buffers.values);
         let mut stepper = GpuStepper {
-            search: Search::new(&ctx),
-            local: LocalStep::new(&ctx),
-            global: GlobalStep::new(&ctx),
-            finish: Finish::new(&ctx, confine),
+            stages,
             reduction,
-            chebyshev: Chebyshev::new(params.chebyshev),
+            chebyshev,
             params,
             constants,
             grid,
@@ -133,10 +159,10 @@ impl GpuStepper {
 
     fn bind(&mut self) {
         let (ctx, b) = (&self.ctx, &self.buffers);
-        self.search.bind(ctx, b);
-        self.local.bind(ctx, b);
-        self.global.bind(ctx, b);
-        self.finish.bind(ctx, b);
+        self.stages.search.bind(ctx, b);
+        self.stages.local.bind(ctx, b);
+        self.stages.global.bind(ctx, b);
+        self.stages.finish.bind(ctx, b);
     }
 
     /// Replaces the fluid's positions (m), velocities (m/s) and materials, as many as the
@@ -209,14 +235,17 @@ impl GpuStepper {
             .queue
             .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&constants));
 
-        let (fluid, boundary) = self.search.sort_and_count(&self.ctx, &self.buffers)?;
+        let (fluid, boundary) = self
+            .stages
+            .search
+            .sort_and_count(&self.ctx, &self.buffers)?;
         if self.buffers.grow_lists(&self.ctx, fluid, boundary) {
             self.bind();
         }
         let mut encoder = self.ctx.encoder();
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.search.record_fill(&mut pass, &self.buffers);
+            self.stages.search.record_fill(&mut pass, &self.buffers);
         }
         self.start_from_prediction(&mut encoder);
         self.ctx.queue.submit([encoder.finish()]);
@@ -239,7 +268,7 @@ impl GpuStepper {
             .queue
             .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
         let mut encoder = self.ctx.encoder();
-        self.finish.record(&mut encoder, b, outcome.result);
+        self.stages.finish.record(&mut encoder, b, outcome.result);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             self.reduction.record(&mut pass);
@@ -320,8 +349,8 @@ impl GpuStepper {
             let mut encoder = self.ctx.encoder();
             {
                 let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.local.record(&mut pass, b, current);
-                self.global.record(&mut pass, b, current);
+                self.stages.local.record(&mut pass, b, current);
+                self.stages.global.record(&mut pass, b, current);
                 self.reduction.record(&mut pass);
             }
             let [compression, moved, _, _] = self.reduction.read(&self.ctx, encoder)?;
@@ -356,6 +385,27 @@ impl GpuStepper {
             result: current,
         })
     }
+}
+
+/// The compiled stages of a step, kept when a stepper is remade.
+struct Stages {
+    search: Search,
+    local: LocalStep,
+    global: GlobalStep,
+    finish: Finish,
+}
+
+/// The number of fluid particles of `scene` on the device. Errors when the fluid or the
+/// boundary has more particles than the device's indices reach.
+fn device_count(scene: &Scene) -> Result<u32, Error> {
+    let too_many = |what: &str, count: usize| {
+        Error::invalid(what, count, "must be fewer than 2³² on the GPU backend")
+    };
+    let n = u32::try_from(scene.positions.len())
+        .map_err(|_| too_many("fluid particles", scene.positions.len()))?;
+    u32::try_from(scene.boundary.len())
+        .map_err(|_| too_many("boundary particles", scene.boundary.len()))?;
+    Ok(n)
 }
 
 /// How the outer iteration ended.

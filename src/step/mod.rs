@@ -292,17 +292,7 @@ pub(crate) fn idle_step(ctx: StepContext, dt: f64) -> (StepStats, f64) {
     }
     *wall_load = Load::default();
     let speed = fastest_inflow(bodies, inflow_speed);
-    let stats = StepStats {
-        dt,
-        outer_iterations: 0,
-        inner_iterations: 0,
-        hit_max_iterations: false,
-        rho: 0.0,
-        last_displacement: 0.0,
-        density_error_avg: 0.0,
-        density_error_max: 0.0,
-        timings: StepTimings::default(),
-    };
+    let stats = StepStats::idle(dt);
     let next_dt = pool.install(|| next_step_size(params, &[], gravity, dt, speed));
     (stats, next_dt)
 }
@@ -360,7 +350,14 @@ fn next_step_size(
     body_speed: f64,
 ) -> f64 {
     let v_max = reduce::max(velocities, |v| (v + gravity * dt).norm_squared());
-    let v_max = v_max.max(1e-9).sqrt().max(body_speed);
+    cfl_step(params, v_max.sqrt().max(body_speed))
+}
+
+/// The CFL rule's step for the fastest speed `v_max` (m/s, at least √10⁻⁹ counted):
+/// λ·0.4·2r / v_max clamped to [Δt_min, Δt_max] (s), Δt_min where it is not finite. The CPU
+/// and GPU backends both end their steps with it (docs/method.md §8).
+pub(crate) fn cfl_step(params: &Params, v_max: f64) -> f64 {
+    let v_max = v_max.max(1e-9f64.sqrt());
     let cfl = params.cfl_factor * 0.4 * params.spacing() / v_max;
     if cfl.is_finite() {
         cfl.clamp(params.dt_min, params.dt_max)

@@ -144,9 +144,6 @@ impl World {
         if !self.bodies.is_empty() {
             return refuse("bodies");
         }
-        if !self.emitters.is_empty() {
-            return refuse("emitters");
-        }
         if !self.boundary.walls.is_empty() {
             return refuse("container walls built as fields");
         }
@@ -156,12 +153,31 @@ impl World {
         Ok(())
     }
 
-    /// One step of `dt` seconds on the device, after [`World::prepare_steps`]: the fluid is
-    /// uploaded (the stepper made again where the particles or the materials changed in
-    /// number), stepped and read back, then sinks and the domain remove what left.
+    /// One step of `dt` seconds on the device, after [`World::prepare_steps`]: the emitters
+    /// insert their due layers on the host, the fluid is uploaded (the stepper made again
+    /// on the same device where the particles or the materials changed in number), stepped
+    /// and read back, then sinks and the domain remove what left. Errors, the emission
+    /// undone, when the device fails or the emission needs more memory than can be had.
     #[cfg(feature = "gpu")]
     pub(super) fn take_gpu_step(&mut self, dt: f64) -> Result<&crate::stats::StepStats, Error> {
         self.check_gpu_world()?;
+        self.start_step()
+            .map_err(|_| Error::out_of_memory("the working storage of a time step"))?;
+        let taken = self.gpu_step(dt);
+        self.end_step(taken, dt)
+    }
+
+    /// The device's part of [`World::take_gpu_step`]: uploads, steps and reads back the
+    /// fluid, and returns the step's statistics with the next step's size (s), the CFL rule
+    /// counting the emitters' inflow as the CPU's does. A world without fluid only moves
+    /// its clock.
+    #[cfg(feature = "gpu")]
+    fn gpu_step(&mut self, dt: f64) -> Result<(crate::stats::StepStats, f64), Error> {
+        let inflow = self.inflow_speed(self.time + dt);
+        if self.fluid.len() == 0 {
+            let stats = crate::stats::StepStats::idle(dt);
+            return Ok((stats, crate::step::cfl_step(&self.params, inflow)));
+        }
         let fluid_len = self.fluid.len();
         let boundary_len = self.boundary.len();
         let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
@@ -170,7 +186,6 @@ impl World {
             || slot.material_count != material_count
             || slot.context.as_ref().is_none_or(|s| s.len() != fluid_len);
         if stale {
-            slot.context = None;
             let (points, psi) = self.static_boundary()?;
             let scene = crate::gpu::Scene {
                 positions: &self.fluid.positions,
@@ -183,8 +198,11 @@ impl World {
                 mass: self.constraint.mass,
                 membership_floor: self.constraint.membership_floor,
             };
-            let stepper = crate::gpu::GpuStepper::new(scene)?;
             let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
+            let stepper = match slot.context.take() {
+                Some(stepper) => stepper.remake(scene)?,
+                None => crate::gpu::GpuStepper::new(scene)?,
+            };
             slot.context = Some(stepper);
             slot.boundary_len = boundary_len;
             slot.material_count = material_count;
@@ -209,11 +227,8 @@ impl World {
         fluid.velocities = back.velocities;
         fluid.densities = back.densities;
         fluid.supports.clear();
-        self.next_dt = next_dt;
-        self.time += dt;
-        self.steps += 1;
-        self.drain();
-        Ok(self.last.insert(stats))
+        let inflow_dt = crate::step::cfl_step(&self.params, inflow);
+        Ok((stats, next_dt.min(inflow_dt)))
     }
 
     /// The static boundary particles (m) with their Akinci masses ψ (kg), computed here

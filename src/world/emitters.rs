@@ -17,11 +17,9 @@ impl World {
     /// d, until its end time. Lattice points closer than 0.9·d to fluid are skipped. Returns
     /// the emitter's index. Errors, changing nothing, on a non-finite position, a zero or
     /// non-finite direction, a speed that is not positive and finite, a non-finite end time,
-    /// or an opening that holds no lattice point ("zero area") or far too many, and on a
-    /// world on the GPU backend, which does not step emitters yet. It emits fluid of the
-    /// material [`World::set_fluid_material`] last chose.
+    /// or an opening that holds no lattice point ("zero area") or far too many. It emits
+    /// fluid of the material [`World::set_fluid_material`] last chose.
     pub fn add_emitter(&mut self, spec: EmitterSpec) -> Result<EmitterId, Error> {
-        self.refuse_on_gpu("emitters")?;
         let state = EmitterState {
             spec,
             travelled: self.params.spacing(),

@@ -110,21 +110,12 @@ impl World {
     /// Errors ([`Error::OutOfMemory`]) when the step needs more memory than can be had,
     /// having changed nothing.
     fn take_prepared_step(&mut self, dt: f64) -> Result<&StepStats, Error> {
-        // A world without fluid (all removed) steps on the CPU, which only moves time on.
         #[cfg(feature = "gpu")]
-        if self.gpu.is_some() && self.fluid_count() > 0 {
+        if self.gpu.is_some() {
             return self.take_gpu_step(dt);
         }
         let oom = |_| Error::out_of_memory("the working storage of a time step");
-        self.buffers
-            .undo
-            .before_emission(&self.fluid, &self.emitters);
-        if let Err(e) = self.emit() {
-            self.buffers
-                .undo
-                .undo_emission(&mut self.fluid, &mut self.emitters);
-            return Err(oom(e));
-        }
+        self.start_step().map_err(oom)?;
         let inflow_speed = self.inflow_speed(self.time + dt);
         let idle = self.fluid_count() == 0;
         let World {
@@ -163,17 +154,46 @@ impl World {
             time: *time,
             inflow_speed,
         };
-        let (stats, next_dt) = if idle {
-            idle_step(context, dt)
+        let taken = if idle {
+            Ok(idle_step(context, dt))
         } else {
-            match take_step(context, dt) {
-                Ok(taken) => taken,
-                Err(e) => {
-                    self.buffers
-                        .undo
-                        .undo_emission(&mut self.fluid, &mut self.emitters);
-                    return Err(oom(e));
-                }
+            take_step(context, dt).map_err(oom)
+        };
+        self.end_step(taken, dt)
+    }
+
+    /// Starts a step: the emitters insert their due layers, remembered so that
+    /// [`World::end_step`] can undo them. Errors, the emission undone, when it needs more
+    /// memory than can be had.
+    pub(super) fn start_step(&mut self) -> Result<(), std::collections::TryReserveError> {
+        self.buffers
+            .undo
+            .before_emission(&self.fluid, &self.emitters);
+        let emitted = self.emit();
+        if emitted.is_err() {
+            self.buffers
+                .undo
+                .undo_emission(&mut self.fluid, &mut self.emitters);
+        }
+        emitted
+    }
+
+    /// Ends a step of `dt` seconds that was `taken` (its statistics and the next step's
+    /// size, s) after the emitters inserted their due layers: moves the clock and the
+    /// emitters on and lets sinks and the domain remove what left; or, where the step
+    /// failed, undoes the emission and returns the error, the world as it was.
+    pub(super) fn end_step(
+        &mut self,
+        taken: Result<(StepStats, f64), Error>,
+        dt: f64,
+    ) -> Result<&StepStats, Error> {
+        let (stats, next_dt) = match taken {
+            Ok(taken) => taken,
+            Err(e) => {
+                self.buffers
+                    .undo
+                    .undo_emission(&mut self.fluid, &mut self.emitters);
+                return Err(e);
             }
         };
         self.next_dt = next_dt;

@@ -29,6 +29,8 @@ pub(crate) struct VorticityConfinement {
     epsilon: f64,
     /// Every fluid particle's vorticity ω_i (1/s).
     vorticities: Vec<Vec3>,
+    /// Every fluid particle's |ω_i| (1/s).
+    magnitudes: Vec<f64>,
 }
 
 impl VorticityConfinement {
@@ -37,13 +39,15 @@ impl VorticityConfinement {
         Self {
             epsilon,
             vorticities: Vec::new(),
+            magnitudes: Vec::new(),
         }
     }
 }
 
 impl NonPressureForce for VorticityConfinement {
     fn try_reserve(&mut self, particles: usize) -> Result<(), std::collections::TryReserveError> {
-        reserve_total(&mut self.vorticities, particles)
+        reserve_total(&mut self.vorticities, particles)?;
+        reserve_total(&mut self.magnitudes, particles)
     }
 
     fn apply(&mut self, f: &Forcing, fluid: &mut Fluid, scratch: &mut Vec<Vec3>) {
@@ -60,12 +64,16 @@ impl NonPressureForce for VorticityConfinement {
                     * volume
             }));
         let omega = &self.vorticities;
+        self.magnitudes.clear();
+        self.magnitudes
+            .par_extend(omega.par_iter().map(|w| w.norm()));
+        let norms = &self.magnitudes;
         let scale = self.epsilon * kernel.support_radius() * f.dt;
         scratch.clear();
         scratch.par_extend((0..x.len()).into_par_iter().map(|i| {
-            let magnitude = omega[i].norm();
+            let magnitude = norms[i];
             let eta: Vec3 = neighbors(i)
-                .map(|j| kernel.grad_w(&(x[i] - x[j])) * (omega[j].norm() - magnitude))
+                .map(|j| kernel.grad_w(&(x[i] - x[j])) * (norms[j] - magnitude))
                 .sum();
             let length = eta.norm();
             if length > 0.0 && magnitude > 0.0 {

@@ -73,6 +73,18 @@ pub(crate) struct GpuStepper {
     chebyshev: Chebyshev,
     /// δ_k of the outer iterations of the current step (m).
     displacements: Vec<f64>,
+    /// The host's copies of what [`GpuStepper::upload`] writes, kept between steps.
+    staging: Staging,
+}
+
+/// Per-particle values in device form on their way to the device: reused by every upload,
+/// which allocates only when the fluid grows.
+#[derive(Default)]
+struct Staging {
+    /// Positions or velocities, four floats each.
+    vectors: Vec<[f32; 4]>,
+    /// Slot indices or materials.
+    words: Vec<u32>,
 }
 
 impl GpuStepper {
@@ -144,6 +156,7 @@ impl GpuStepper {
             constants,
             grid,
             displacements: Vec::new(),
+            staging: Staging::default(),
             buffers,
             ctx,
         };
@@ -173,29 +186,32 @@ impl GpuStepper {
         velocities: &[Vec3],
         materials: &[MaterialId],
     ) -> Result<(), Error> {
-        let b = &self.buffers;
-        let x: Vec<[f32; 4]> = positions
-            .iter()
-            .map(|&p| self.grid.device_position(p))
-            .collect();
-        let v: Vec<[f32; 4]> = velocities
-            .iter()
-            .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0])
-            .collect();
-        let ids: Vec<u32> = (0..b.n).collect();
-        let materials: Vec<u32> = materials.iter().map(|&m| u32::from(m)).collect();
+        let (b, s, grid) = (&self.buffers, &mut self.staging, &self.grid);
+        s.vectors.clear();
+        s.vectors
+            .extend(positions.iter().map(|&p| grid.device_position(p)));
         self.ctx
             .queue
-            .write_buffer(&b.x, 0, bytemuck::cast_slice(&x));
+            .write_buffer(&b.x, 0, bytemuck::cast_slice(&s.vectors));
+        s.vectors.clear();
+        s.vectors.extend(
+            velocities
+                .iter()
+                .map(|v| [v.x as f32, v.y as f32, v.z as f32, 0.0]),
+        );
         self.ctx
             .queue
-            .write_buffer(&b.v, 0, bytemuck::cast_slice(&v));
+            .write_buffer(&b.v, 0, bytemuck::cast_slice(&s.vectors));
+        s.words.clear();
+        s.words.extend(0..b.n);
         self.ctx
             .queue
-            .write_buffer(&b.ids, 0, bytemuck::cast_slice(&ids));
+            .write_buffer(&b.ids, 0, bytemuck::cast_slice(&s.words));
+        s.words.clear();
+        s.words.extend(materials.iter().map(|&m| u32::from(m)));
         self.ctx
             .queue
-            .write_buffer(&b.material, 0, bytemuck::cast_slice(&materials));
+            .write_buffer(&b.material, 0, bytemuck::cast_slice(&s.words));
         self.ctx.check()
     }
 

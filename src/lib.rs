@@ -47,6 +47,8 @@ pub use emitter::{Emitter, EmitterShape, EmitterSpec, EmitterState};
 pub use error::Error;
 pub use material::{Material, MaterialId};
 pub use params::{ChebyshevParams, Omega2Rule, Params, ProjectionWeight, SolverKind};
+#[cfg(feature = "gpu")]
+pub use world::GpuPositions;
 pub use world::{Backend, BodyId, EmitterId, GridParts, SinkId, World, WorldState};
 
 /// A 3-vector of f64 (metres, metres per second, …).

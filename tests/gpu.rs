@@ -918,3 +918,124 @@ fn an_emitter_pours_on_the_gpu_as_on_the_cpu() {
     assert_eq!(again_removed, gpu_removed);
     assert!(again.positions == gpu.positions, "positions differ");
 }
+
+/// Polls `future` to its end on this thread: wgpu's native futures resolve without an
+/// executor.
+fn block_on<F: std::future::Future>(future: F) -> F::Output {
+    let mut future = std::pin::pin!(future);
+    let mut context = std::task::Context::from_waker(std::task::Waker::noop());
+    loop {
+        if let std::task::Poll::Ready(value) = future.as_mut().poll(&mut context) {
+            return value;
+        }
+        std::thread::yield_now();
+    }
+}
+
+/// A device and queue as an engine makes them, from the first Vulkan adapter, with
+/// `storage_buffers` storage buffers per shader stage in its limits.
+fn engine_device(storage_buffers: u32) -> (wgpu::Device, wgpu::Queue) {
+    let mut desc = wgpu::InstanceDescriptor::new_without_display_handle();
+    desc.backends = wgpu::Backends::VULKAN;
+    let instance = wgpu::Instance::new(desc);
+    let adapter = block_on(instance.request_adapter(&wgpu::RequestAdapterOptions::default()))
+        .expect("a Vulkan adapter (lavapipe in CI)");
+    let required_limits = wgpu::Limits {
+        max_storage_buffers_per_shader_stage: storage_buffers,
+        ..wgpu::Limits::default()
+    };
+    block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+        required_limits,
+        ..Default::default()
+    }))
+    .expect("a device")
+}
+
+/// The device buffer's positions in the world frame, read back through the engine's
+/// device and sorted, with the world's own read sorted alike.
+fn bound_positions(world: &World, device: &wgpu::Device, queue: &wgpu::Queue) -> Vec<[f64; 3]> {
+    let bound = world.gpu_positions().expect("a step was taken on the GPU");
+    let bytes = u64::from(bound.count) * 16;
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("engine read-back"),
+        size: bytes,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_buffer_to_buffer(bound.buffer, 0, &staging, 0, bytes);
+    queue.submit([encoder.finish()]);
+    staging.map_async(wgpu::MapMode::Read, .., |r| r.expect("mapped"));
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .expect("the device finishes");
+    let data = staging
+        .get_mapped_range(..)
+        .expect("the mapped range")
+        .to_vec();
+    let mut points: Vec<[f64; 3]> = data
+        .chunks_exact(16)
+        .map(|c| {
+            let f = |k: usize| f32::from_le_bytes([c[k], c[k + 1], c[k + 2], c[k + 3]]);
+            let p = Vec3::new(f(0).into(), f(4).into(), f(8).into()) + bound.origin;
+            [p.x, p.y, p.z]
+        })
+        .collect();
+    points.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
+    points
+}
+
+/// An engine's own device steps a world as the one projfluid opens does, to the bit, and
+/// the position buffer it can bind holds the positions `World::positions` reads; the
+/// engine's uncaptured-error handler is left in place; a device with too few storage
+/// buffers per stage is refused, naming the limit, and the world stays on the CPU.
+#[test]
+fn a_world_steps_on_the_engines_device_and_shares_its_positions() {
+    let (device, queue) = engine_device(12);
+    let caught = std::sync::Arc::new(std::sync::atomic::AtomicUsize::new(0));
+    let counter = std::sync::Arc::clone(&caught);
+    device.on_uncaptured_error(std::sync::Arc::new(move |_: wgpu::Error| {
+        counter.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+    }));
+    let mut engines = dam_break();
+    assert!(engines.gpu_positions().is_none());
+    engines
+        .set_gpu_device(device.clone(), queue.clone())
+        .expect("the engine's device");
+    assert_eq!(engines.backend(), Backend::Gpu);
+    assert!(
+        engines.gpu_positions().is_none(),
+        "nothing is on the device before a step"
+    );
+    let own = run(on_gpu(dam_break()), 0.1, &dam_container());
+    engines.advance(0.1).expect("steps on the engine's device");
+    assert!(engines.positions() == own.positions, "positions differ");
+    let mut read: Vec<[f64; 3]> = engines
+        .positions()
+        .iter()
+        .map(|p| [p.x, p.y, p.z])
+        .collect();
+    read.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
+    assert_eq!(bound_positions(&engines, &device, &queue), read);
+    // The engine's handler still hears of the engine's own mistakes.
+    assert_eq!(caught.load(std::sync::atomic::Ordering::SeqCst), 0);
+    let _bad = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("unaligned and mapped"),
+        size: 6,
+        usage: wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: true,
+    });
+    assert_eq!(caught.load(std::sync::atomic::Ordering::SeqCst), 1);
+    // Too few storage buffers per stage for the kernels.
+    let (small, small_queue) = engine_device(8);
+    let mut world = dam_break();
+    let message = world
+        .set_gpu_device(small, small_queue)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        message.contains("backend gpu") && message.contains("max_storage_buffers_per_shader_stage"),
+        "{message}"
+    );
+    assert_eq!(world.backend(), Backend::Cpu);
+}

@@ -22,7 +22,46 @@ pub(super) struct Context {
     pub queue: wgpu::Queue,
     /// The adapter's name and driver, for messages.
     pub adapter: String,
+    /// Where the handler of a device projfluid opened keeps the errors no scope caught; a
+    /// caller's device keeps its own handler, and this stays empty.
     errors: Arc<Mutex<Option<String>>>,
+}
+
+/// Error scopes over one operation on the device ([`Context::scope`]): every error the
+/// device reports for the work issued while they are open is returned by [`Scope::close`].
+/// Dropped without closing, they are popped and their errors dropped.
+pub(super) struct Scope {
+    // Popped in this order, the reverse of their pushing, when dropped.
+    validation: wgpu::ErrorScopeGuard,
+    internal: wgpu::ErrorScopeGuard,
+    memory: wgpu::ErrorScopeGuard,
+    adapter: String,
+}
+
+impl Scope {
+    /// Closes the scopes: `done`'s error if it failed, else the first error the device
+    /// reported within them (out of memory as [`Error::OutOfMemory`]), else `done`'s value.
+    pub fn close<T>(self, done: Result<T, Error>) -> Result<T, Error> {
+        let Scope {
+            validation,
+            internal,
+            memory,
+            adapter,
+        } = self;
+        let validation = block_on(validation.pop());
+        let internal = block_on(internal.pop());
+        let memory = block_on(memory.pop());
+        let value = done?;
+        if let Some(e) = memory {
+            return Err(Error::OutOfMemory(format!(
+                "the GPU {adapter} ran out of memory: {e}"
+            )));
+        }
+        match validation.or(internal) {
+            Some(e) => Err(gpu_error(&format!("failed on the device {adapter}: {e}"))),
+            None => Ok(value),
+        }
+    }
 }
 
 /// What a kernel binds at each slot of its bind group.
@@ -73,13 +112,7 @@ impl Context {
         let info = adapter.get_info();
         let name = format!("{} ({}, {:?})", info.name, info.driver, info.device_type);
         let limits = adapter.limits();
-        if limits.max_storage_buffers_per_shader_stage < STORAGE_BUFFERS {
-            return Err(unavailable(&format!(
-                "the adapter {name} binds {} storage buffers per kernel, {STORAGE_BUFFERS} \
-                 are needed",
-                limits.max_storage_buffers_per_shader_stage
-            )));
-        }
+        check_limits(&limits, &format!("the adapter {name}"))?;
         let required_limits = wgpu::Limits {
             max_storage_buffers_per_shader_stage: STORAGE_BUFFERS,
             max_storage_buffer_binding_size: limits.max_storage_buffer_binding_size,
@@ -108,6 +141,33 @@ impl Context {
             adapter: name,
             errors,
         })
+    }
+
+    /// The caller's `device` and `queue` (an engine's), on which the kernels' storage
+    /// buffers must fit: errors, naming the limit, when the device binds fewer than the
+    /// kernels need. Its uncaptured-error handler is left as it is: every operation of the
+    /// stepper runs in error scopes ([`Context::scope`]).
+    pub fn on(device: wgpu::Device, queue: wgpu::Queue) -> Result<Self, Error> {
+        check_limits(&device.limits(), "the caller's device")?;
+        Ok(Self {
+            device,
+            queue,
+            adapter: "(the caller's device)".to_string(),
+            errors: Arc::new(Mutex::new(None)),
+        })
+    }
+
+    /// Opens error scopes over the work issued until [`Scope::close`].
+    pub fn scope(&self) -> Scope {
+        let memory = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let internal = self.device.push_error_scope(wgpu::ErrorFilter::Internal);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        Scope {
+            validation,
+            internal,
+            memory,
+            adapter: self.adapter.clone(),
+        }
     }
 
     /// The first error the device reported since the last check, as an [`Error`] naming the
@@ -284,6 +344,19 @@ impl Context {
         staging.unmap();
         Ok(bytes[..bytes.len().min(size as usize)].to_vec())
     }
+}
+
+/// Errors, naming `what` and the limit, where `limits` bind fewer storage buffers per
+/// kernel than the kernels need.
+pub(crate) fn check_limits(limits: &wgpu::Limits, what: &str) -> Result<(), Error> {
+    if limits.max_storage_buffers_per_shader_stage >= STORAGE_BUFFERS {
+        return Ok(());
+    }
+    Err(unavailable(&format!(
+        "{what} binds {} storage buffers per kernel (max_storage_buffers_per_shader_stage), \
+         {STORAGE_BUFFERS} are needed",
+        limits.max_storage_buffers_per_shader_stage
+    )))
 }
 
 /// Little-endian bytes read back as f32 values.

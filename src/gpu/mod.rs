@@ -46,6 +46,7 @@ mod scan;
 mod search;
 mod stepper;
 
+pub(crate) use context::check_limits;
 pub(crate) use stepper::{GpuStepper, Scene};
 
 /// Opens the device once, to tell whether the GPU backend can run here; errors as

@@ -49,6 +49,8 @@ pub(crate) struct Scene<'a> {
     pub mass: f64,
     /// The fewest stencils the global step counts a particle in (docs/method.md §3.1).
     pub membership_floor: f64,
+    /// The caller's device and queue, or `None` for a device the stepper opens.
+    pub device: Option<&'a (wgpu::Device, wgpu::Queue)>,
 }
 
 /// The fluid's state read back from the device, in the device's order.
@@ -92,7 +94,11 @@ impl GpuStepper {
     /// the scene has more particles than the device's indices reach.
     pub fn new(scene: Scene) -> Result<Self, Error> {
         let n = device_count(&scene)?;
-        let ctx = Context::new()?;
+        let ctx = match scene.device {
+            Some((device, queue)) => Context::on(device.clone(), queue.clone())?,
+            None => Context::new()?,
+        };
+        let scope = ctx.scope();
         let confine = scene.params.vorticity_confinement > 0.0;
         let stages = Stages {
             search: Search::new(&ctx),
@@ -102,7 +108,7 @@ impl GpuStepper {
         };
         let reduce = Reduction::compile(&ctx);
         let chebyshev = Chebyshev::new(scene.params.chebyshev);
-        Self::assemble(ctx, stages, reduce, chebyshev, n, scene)
+        scope.close(Self::assemble(ctx, stages, reduce, chebyshev, n, scene))
     }
 
     /// The stepper for `scene`, a world with another number of fluid or boundary particles or
@@ -111,6 +117,7 @@ impl GpuStepper {
     /// stepper was made with. Errors as [`GpuStepper::new`], when the device fails.
     pub fn remake(self, scene: Scene) -> Result<Self, Error> {
         let n = device_count(&scene)?;
+        let scope = self.ctx.scope();
         let GpuStepper {
             ctx,
             stages,
@@ -118,7 +125,8 @@ impl GpuStepper {
             chebyshev,
             ..
         } = self;
-        Self::assemble(ctx, stages, reduction.into_kernel(), chebyshev, n, scene)
+        let remade = Self::assemble(ctx, stages, reduction.into_kernel(), chebyshev, n, scene);
+        scope.close(remade)
     }
 
     /// The stepper of `n` fluid particles from `scene` on `ctx`, with its compiled `stages`
@@ -186,6 +194,7 @@ impl GpuStepper {
         velocities: &[Vec3],
         materials: &[MaterialId],
     ) -> Result<(), Error> {
+        let scope = self.ctx.scope();
         let (b, s, grid) = (&self.buffers, &mut self.staging, &self.grid);
         s.vectors.clear();
         s.vectors
@@ -212,11 +221,24 @@ impl GpuStepper {
         self.ctx
             .queue
             .write_buffer(&b.material, 0, bytemuck::cast_slice(&s.words));
-        self.ctx.check()
+        scope.close(self.ctx.check())
     }
 
     /// Copies the fluid's state back from the device.
     pub fn read(&self) -> Result<Readback, Error> {
+        let scope = self.ctx.scope();
+        scope.close(self.read_back())
+    }
+
+    /// The device's position buffer after the last step, in the device's order of the
+    /// particles ([`Readback::order`]), with their count and the point the positions are
+    /// measured from (m, world frame): one `vec4<f32>` per particle, x, y, z in metres from
+    /// that point and w unused.
+    pub fn positions(&self) -> (&wgpu::Buffer, u32, Vec3) {
+        (&self.buffers.x, self.buffers.n, self.grid.centre)
+    }
+
+    fn read_back(&self) -> Result<Readback, Error> {
         let b = &self.buffers;
         let n = u64::from(b.n);
         let x = floats(&self.ctx.read(self.ctx.encoder(), &b.x, n * 16)?);
@@ -242,6 +264,13 @@ impl GpuStepper {
     /// size of the next step by the CFL rule (s). Errors when the device fails; the
     /// fluid's state on the device is then undefined.
     pub fn step(&mut self, dt: f64) -> Result<(StepStats, f64), Error> {
+        let scope = self.ctx.scope();
+        let taken = self.advance(dt);
+        scope.close(taken)
+    }
+
+    /// [`GpuStepper::step`] within its error scopes.
+    fn advance(&mut self, dt: f64) -> Result<(StepStats, f64), Error> {
         let started = Instant::now();
         let params = &self.params;
         let mut constants = self.constants;

@@ -120,11 +120,7 @@ impl World {
     fn open_gpu(&mut self) -> Result<(), Error> {
         self.check_gpu_world()?;
         if self.gpu.is_none() {
-            self.gpu = Some(Box::new(GpuSlot {
-                context: None,
-                boundary_len: usize::MAX,
-                material_count: 0,
-            }));
+            self.gpu = Some(Box::new(GpuSlot::on(None)));
             // The device is opened now, so that a missing adapter is reported here.
             if let Err(e) = crate::gpu::probe() {
                 self.gpu = None;
@@ -136,7 +132,7 @@ impl World {
 
     /// Errors, naming the feature, when the world holds what the GPU backend does not step.
     #[cfg(feature = "gpu")]
-    fn check_gpu_world(&self) -> Result<(), Error> {
+    pub(super) fn check_gpu_world(&self) -> Result<(), Error> {
         let refuse = |what: &str| Err(unsupported(what));
         if !gpu_solver(self.params.solver) {
             return refuse(&format!("the {} solver", self.params.solver.name()));
@@ -186,6 +182,7 @@ impl World {
             || slot.material_count != material_count
             || slot.context.as_ref().is_none_or(|s| s.len() != fluid_len);
         if stale {
+            let device = slot.device.clone();
             let (points, psi) = self.static_boundary()?;
             let scene = crate::gpu::Scene {
                 positions: &self.fluid.positions,
@@ -197,6 +194,7 @@ impl World {
                 params: &self.params,
                 mass: self.constraint.mass,
                 membership_floor: self.constraint.membership_floor,
+                device: device.as_ref(),
             };
             let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
             let stepper = match slot.context.take() {
@@ -256,11 +254,28 @@ impl World {
 /// the particles or the materials change in number.
 #[cfg(feature = "gpu")]
 pub(crate) struct GpuSlot {
-    context: Option<crate::gpu::GpuStepper>,
+    pub(super) context: Option<crate::gpu::GpuStepper>,
+    /// The caller's device and queue ([`World::set_gpu_device`]), or `None` for one the
+    /// stepper opens.
+    pub(super) device: Option<(wgpu::Device, wgpu::Queue)>,
     /// Boundary particles the stepper was made with.
-    boundary_len: usize,
+    pub(super) boundary_len: usize,
     /// Materials the stepper was made with (their mass ratios are among its constants).
-    material_count: usize,
+    pub(super) material_count: usize,
+}
+
+#[cfg(feature = "gpu")]
+impl GpuSlot {
+    /// A slot whose stepper is made at the next step, on `device` (the caller's device and
+    /// queue) or on one it opens.
+    pub(super) fn on(device: Option<(wgpu::Device, wgpu::Queue)>) -> Self {
+        Self {
+            context: None,
+            device,
+            boundary_len: usize::MAX,
+            material_count: 0,
+        }
+    }
 }
 
 #[cfg(test)]

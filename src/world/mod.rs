@@ -9,6 +9,8 @@ mod backend;
 mod bodies;
 mod emitters;
 mod fill;
+#[cfg(feature = "gpu")]
+mod gpu_device;
 mod materials;
 mod placement;
 mod read;
@@ -24,6 +26,8 @@ pub use backend::Backend;
 pub(crate) use backend::gpu_error;
 pub use bodies::BodyId;
 pub use emitters::EmitterId;
+#[cfg(feature = "gpu")]
+pub use gpu_device::GpuPositions;
 pub use sinks::SinkId;
 pub(crate) use snapshot::Snapshot;
 pub use state::{GridParts, WorldState};

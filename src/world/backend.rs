@@ -17,9 +17,9 @@ pub enum Backend {
     #[default]
     Cpu,
     /// A graphics card through Vulkan compute shaders, in single precision (feature `gpu`),
-    /// with several materials and vorticity confinement as on the CPU. Not yet with bodies,
-    /// emitters, walls built as fields or the physical viscosity; the solver is Chebyshev's
-    /// or one Jacobi sweep. The warm start and the coarse correction are left out on it
+    /// with several materials, vorticity confinement, emitters, sinks and the domain as on
+    /// the CPU. Not yet with bodies, walls built as fields or the physical viscosity; the
+    /// solver is Chebyshev's or one Jacobi sweep. The warm start and the coarse correction are left out on it
     /// (docs/method.md §4.1, §3.8).
     Gpu,
 }

@@ -45,6 +45,13 @@ pub(crate) struct Viscosity {
     calibration: Vec<f64>,
     /// The inverse of each particle's 3×3 diagonal block.
     preconditioner: Vec<Matrix3<f64>>,
+    /// Every pair's coupling ν_ij·g_ij of the step (m²/s per m⁴·…, [`Operator::coupled`]),
+    /// particle by particle in the order [`Operator::visit`] takes them, so that the
+    /// solve's iterations do not evaluate the kernel again; empty where their memory could
+    /// not be had, the iterations then evaluating it.
+    couplings: Vec<f64>,
+    /// Where each particle's couplings start in `couplings` (one past the particles).
+    starts: Vec<usize>,
     residual: Vec<Vec3>,
     preconditioned: Vec<Vec3>,
     direction: Vec<Vec3>,
@@ -59,12 +66,21 @@ impl Viscosity {
             volumes: Vec::new(),
             calibration: Vec::new(),
             preconditioner: Vec::new(),
+            couplings: Vec::new(),
+            starts: Vec::new(),
             residual: Vec::new(),
             preconditioned: Vec::new(),
             direction: Vec::new(),
             product: Vec::new(),
         }
     }
+}
+
+/// The other particle of a pair: a fluid particle or a boundary particle, by index.
+#[derive(Clone, Copy)]
+enum Partner {
+    Fluid(usize),
+    Wall(usize),
 }
 
 /// What the operator reads: positions (m), materials, volumes (m³), the calibration, and the
@@ -77,6 +93,10 @@ struct Operator<'a> {
     volumes: &'a [f64],
     /// κ_i, or empty while it is being measured (then 1).
     calibration: &'a [f64],
+    /// The pairs' couplings and where each particle's start ([`Viscosity::couplings`]),
+    /// or empty slices while they are not known.
+    couplings: &'a [f64],
+    starts: &'a [usize],
     coupling: f64,
     epsilon: f64,
     no_slip: bool,
@@ -122,34 +142,68 @@ impl Operator<'_> {
         self.calibration.get(i).copied().unwrap_or(1.0)
     }
 
+    /// Calls `each(r, Partner)` for every fluid neighbour of `i` and every boundary
+    /// neighbour that holds the fluid (no slip), in a fixed order, r = x_i − x_partner (m).
+    #[inline]
+    fn visit(&self, i: usize, mut each: impl FnMut(Vec3, Partner)) {
+        let xi = self.x[i];
+        for &j in self.f.nb.fluid.of(i) {
+            let j = j as usize;
+            each(xi - self.x[j], Partner::Fluid(j));
+        }
+        if self.no_slip {
+            for &b in self.f.nb.boundary.of(i) {
+                let b = b as usize;
+                if !self.f.boundary.is_moving_particle(b) {
+                    let r = xi - self.f.nb.boundary_positions.at(b);
+                    each(r, Partner::Wall(b));
+                }
+            }
+        }
+    }
+
     /// Calls `each(g, r, Some(j))` for every fluid neighbour j of `i` and `each(g, r, None)`
     /// for every boundary neighbour that holds the fluid (no slip), g including V_j and the
     /// pair's calibration (κ_i + κ_j)/2, or κ_i towards a wall.
     #[inline]
     fn for_pairs(&self, i: usize, mut each: impl FnMut(f64, Vec3, Option<usize>)) {
-        let xi = self.x[i];
         let ki = self.kappa(i);
-        for &j in self.f.nb.fluid.of(i) {
-            let j = j as usize;
-            let r = xi - self.x[j];
-            let kij = 0.5 * (ki + self.kappa(j));
-            each(kij * self.weight(&r) * self.volumes[j], r, Some(j));
-        }
-        if self.no_slip {
-            let rest = self.f.constraint.rest_density;
-            for &b in self.f.nb.boundary.of(i) {
-                let b = b as usize;
-                if self.f.boundary.is_moving_particle(b) {
-                    continue;
-                }
-                let r = xi - self.f.nb.boundary_positions.at(b);
-                each(
-                    ki * self.weight(&r) * self.f.nb.boundary_psi[b] / rest,
-                    r,
-                    None,
-                );
+        let rest = self.f.constraint.rest_density;
+        self.visit(i, |r, partner| match partner {
+            Partner::Fluid(j) => {
+                let kij = 0.5 * (ki + self.kappa(j));
+                each(kij * self.weight(&r) * self.volumes[j], r, Some(j));
             }
+            Partner::Wall(b) => {
+                let g = ki * self.weight(&r) * self.f.nb.boundary_psi[b] / rest;
+                each(g, r, None);
+            }
+        });
+    }
+
+    /// [`Operator::for_pairs`] with the pair's viscosity: `each(ν_ij·g, r, partner)`, read
+    /// from the step's couplings where they are known.
+    #[inline]
+    fn coupled(&self, i: usize, mut each: impl FnMut(f64, Vec3, Option<usize>)) {
+        if self.starts.is_empty() {
+            return self.for_pairs(i, |g, r, j| each(g * self.pair_nu(i, j), r, j));
         }
+        let mut k = self.starts[i];
+        self.visit(i, |r, partner| {
+            let j = match partner {
+                Partner::Fluid(j) => Some(j),
+                Partner::Wall(_) => None,
+            };
+            each(self.couplings[k], r, j);
+            k += 1;
+        });
+    }
+
+    /// The number of pairs [`Operator::visit`] takes for particle `i`.
+    fn pair_count(&self, i: usize) -> usize {
+        let mut count = 0;
+        self.visit(i, |_, _| count += 1);
+        count
     }
 
     /// κ_i = 2 / (2(d+2) S_i), S_i = Σ_j V_j g_ij ⟨x_a² x_b²⟩ the mean over the three
@@ -173,9 +227,9 @@ impl Operator<'_> {
     fn apply(&self, v: &[Vec3], i: usize) -> Vec3 {
         let mut sum = Vec3::zeros();
         let vi = v[i];
-        self.for_pairs(i, |g, r, j| {
+        self.coupled(i, |c, r, j| {
             let relative = j.map_or(vi, |j| vi - v[j]);
-            sum += r * (g * self.pair_nu(i, j) * r.dot(&relative));
+            sum += r * (c * r.dot(&relative));
         });
         self.volumes[i] * (vi + sum * self.coupling)
     }
@@ -183,9 +237,7 @@ impl Operator<'_> {
     /// The inverse of particle `i`'s diagonal block V_i (I + c Σ ν_ij g r rᵀ).
     fn block_inverse(&self, i: usize) -> Matrix3<f64> {
         let mut sum = Matrix3::zeros();
-        self.for_pairs(i, |g, r, j| {
-            sum += r * r.transpose() * (g * self.pair_nu(i, j))
-        });
+        self.coupled(i, |c, r, _| sum += r * r.transpose() * c);
         let block = (Matrix3::identity() + sum * self.coupling) * self.volumes[i];
         block
             .try_inverse()
@@ -222,6 +274,8 @@ impl NonPressureForce for Viscosity {
             materials: &fluid.materials,
             volumes: &self.volumes,
             calibration: &[],
+            couplings: &[],
+            starts: &[],
             coupling: LAPLACIAN_FACTOR * f.dt,
             epsilon: REGULARISATION * h * h,
             no_slip: self.no_slip,
@@ -230,6 +284,27 @@ impl NonPressureForce for Viscosity {
         self.calibration
             .par_extend((0..n).into_par_iter().map(|i| op.calibration(i)));
         op.calibration = &self.calibration;
+        // The couplings, where their memory can be had (else the iterations evaluate them).
+        self.starts.clear();
+        self.couplings.clear();
+        let mut total = 0usize;
+        if self.starts.try_reserve(n + 1).is_ok() {
+            self.starts.push(0);
+            for i in 0..n {
+                total += op.pair_count(i);
+                self.starts.push(total);
+            }
+        }
+        if self.starts.len() == n + 1 && self.couplings.try_reserve(total).is_ok() {
+            // In order, within the capacity just reserved.
+            for i in 0..n {
+                op.coupled(i, |c, _, _| self.couplings.push(c));
+            }
+        } else {
+            self.starts.clear();
+        }
+        op.couplings = &self.couplings;
+        op.starts = &self.starts;
         self.preconditioner.clear();
         self.preconditioner
             .par_extend((0..n).into_par_iter().map(|i| op.block_inverse(i)));

@@ -36,6 +36,14 @@ fn on_gpu(mut world: World) -> World {
     world
 }
 
+/// `world` on `backend`: switched to the GPU ([`on_gpu`]) or left on the CPU.
+fn on_backend(world: World, backend: Backend) -> World {
+    match backend {
+        Backend::Gpu => on_gpu(world),
+        Backend::Cpu => world,
+    }
+}
+
 fn dam_break() -> World {
     Scene::builtin("dam_break_small")
         .expect("a built-in scene")
@@ -46,6 +54,9 @@ fn dam_break() -> World {
 /// What the comparisons read from a world after a run.
 struct Run {
     count: usize,
+    /// The fluid count after each step, and the particles sinks and the domain removed.
+    counts: Vec<usize>,
+    removed: u64,
     kinetic: f64,
     /// The largest x of the fluid (m): the surge front of the dam break.
     front: f64,
@@ -60,13 +71,14 @@ struct Run {
 }
 
 fn run(mut world: World, seconds: f64, container: &Aabb) -> Run {
-    let (mut density_errors, mut iterations) = (Vec::new(), Vec::new());
+    let (mut density_errors, mut iterations, mut counts) = (Vec::new(), Vec::new(), Vec::new());
     let started = std::time::Instant::now();
     let steps = world
         .advance_with(seconds, |w| {
             let stats = w.last_step().expect("a step was taken");
             density_errors.push(stats.density_error_avg);
             iterations.push(stats.outer_iterations);
+            counts.push(w.fluid_count());
             Ok(())
         })
         .expect("the run steps");
@@ -83,6 +95,8 @@ fn run(mut world: World, seconds: f64, container: &Aabb) -> Run {
         .count();
     Run {
         count: world.fluid_count(),
+        counts,
+        removed: world.removed_count(),
         kinetic: world.kinetic_energy(),
         front: positions.iter().map(|p| p.x).fold(f64::MIN, f64::max),
         escaped,
@@ -652,7 +666,7 @@ fn a_scene_for_the_gpu_and_its_checkpoint_run_there() {
 /// keeps over `seconds` with confinement `epsilon`, on `backend`; and its kinetic energy
 /// after (J).
 fn vortex_kept(epsilon: f64, backend: Backend, seconds: f64) -> (f64, f64) {
-    let (mut world, axis) = vortex(
+    let (world, axis) = vortex(
         Params {
             vorticity_confinement: epsilon,
             ..Params::default()
@@ -660,9 +674,7 @@ fn vortex_kept(epsilon: f64, backend: Backend, seconds: f64) -> (f64, f64) {
         [20, 20, 4],
         0.15,
     );
-    if backend == Backend::Gpu {
-        world = on_gpu(world);
-    }
+    let mut world = on_backend(world, backend);
     let start = swirl(&world, axis, 0.1, 0.25);
     let started = std::time::Instant::now();
     let steps = world.advance(seconds).expect("the run steps");
@@ -792,10 +804,7 @@ fn material_means(world: &World, material: u16) -> (f64, f64) {
 fn a_heavy_blob_sinks_on_the_gpu_as_on_the_cpu() {
     let seconds = 1.0;
     let drop = |blob: f64, backend: Backend| {
-        let mut world = blob_world(blob);
-        if backend == Backend::Gpu {
-            world = on_gpu(world);
-        }
+        let mut world = on_backend(blob_world(blob), backend);
         let materials = world.particle_materials();
         let (start, _) = material_means(&world, 1);
         let started = std::time::Instant::now();
@@ -859,28 +868,16 @@ fn two_liquids_on_the_gpu_agree_to_the_bit() {
     assert!(a.0 != neutral.0, "the heavy blob changed nothing");
 }
 
-/// The built-in `fountain` (a disc emitter pouring into a pool with a drain) for
-/// `seconds`, on `backend`: its fluid count after every step, its removed count, and the
-/// run's end as [`Run`] reads it.
-fn fountain(backend: Backend, seconds: f64) -> (Vec<usize>, u64, Run) {
+/// The built-in `fountain` (a disc emitter pouring into a pool with a drain) run for
+/// `seconds` on `backend`.
+fn fountain(backend: Backend, seconds: f64) -> Run {
     let scene = Scene::builtin("fountain").expect("a built-in scene");
-    let mut world = scene.build_world().expect("the scene builds");
-    if backend == Backend::Gpu {
-        world = on_gpu(world);
-    }
-    let mut counts = Vec::new();
-    world
-        .advance_with(seconds, |w| {
-            counts.push(w.fluid_count());
-            Ok(())
-        })
-        .expect("the run");
-    let removed = world.removed_count();
+    let world = scene.build_world().expect("the scene builds");
     let basin = Aabb {
         min: Vec3::repeat(-0.00625),
         max: Vec3::new(1.00625, 1.20625, 1.00625),
     };
-    (counts, removed, run(world, 0.0, &basin))
+    run(on_backend(world, backend), seconds, &basin)
 }
 
 /// Emitters run on the GPU: the fountain pours and drains there as on the CPU over 0.6 s
@@ -889,19 +886,15 @@ fn fountain(backend: Backend, seconds: f64) -> (Vec<usize>, u64, Run) {
 /// two GPU runs agree to the bit.
 #[test]
 fn an_emitter_pours_on_the_gpu_as_on_the_cpu() {
-    let (cpu_counts, cpu_removed, cpu) = fountain(Backend::Cpu, 0.6);
-    let (gpu_counts, gpu_removed, gpu) = fountain(Backend::Gpu, 0.6);
-    let made = |counts: &[usize], removed: u64| counts.last().unwrap() + removed as usize;
-    let (on_cpu, on_gpu) = (
-        made(&cpu_counts, cpu_removed),
-        made(&gpu_counts, gpu_removed),
-    );
+    let (cpu, gpu) = (fountain(Backend::Cpu, 0.6), fountain(Backend::Gpu, 0.6));
+    let made = |run: &Run| run.counts.last().unwrap() + run.removed as usize;
+    let (on_cpu, on_gpu) = (made(&cpu), made(&gpu));
     assert!(
         on_cpu > 1444 + 200,
         "the emitter added {} particles",
         on_cpu - 1444
     );
-    assert!(gpu_removed > 0, "the drain removed nothing");
+    assert!(gpu.removed > 0, "the drain removed nothing");
     assert!(
         on_cpu.abs_diff(on_gpu) <= on_cpu / 100,
         "particles made: {on_cpu} on the CPU, {on_gpu} on the GPU"
@@ -913,9 +906,9 @@ fn an_emitter_pours_on_the_gpu_as_on_the_cpu() {
         gpu.kinetic,
         cpu.kinetic
     );
-    let (again_counts, again_removed, again) = fountain(Backend::Gpu, 0.6);
-    assert_eq!(again_counts, gpu_counts);
-    assert_eq!(again_removed, gpu_removed);
+    let again = fountain(Backend::Gpu, 0.6);
+    assert_eq!(again.counts, gpu.counts);
+    assert_eq!(again.removed, gpu.removed);
     assert!(again.positions == gpu.positions, "positions differ");
 }
 

@@ -45,7 +45,7 @@ pub(crate) struct Viscosity {
     calibration: Vec<f64>,
     /// The inverse of each particle's 3×3 diagonal block.
     preconditioner: Vec<Matrix3<f64>>,
-    /// Every pair's coupling ν_ij·g_ij of the step (m²/s per m⁴·…, [`Operator::coupled`]),
+    /// Every pair's coupling ν_ij·g_ij of the step (1/(m²·s), [`Operator::coupled`]),
     /// particle by particle in the order [`Operator::visit`] takes them, so that the
     /// solve's iterations do not evaluate the kernel again; empty where their memory could
     /// not be had, the iterations then evaluating it.
@@ -250,6 +250,7 @@ impl NonPressureForce for Viscosity {
         reserve_total(&mut self.volumes, particles)?;
         reserve_total(&mut self.calibration, particles)?;
         reserve_total(&mut self.preconditioner, particles)?;
+        reserve_total(&mut self.starts, particles + 1)?;
         for v in [
             &mut self.residual,
             &mut self.preconditioned,
@@ -288,14 +289,12 @@ impl NonPressureForce for Viscosity {
         self.starts.clear();
         self.couplings.clear();
         let mut total = 0usize;
-        if self.starts.try_reserve(n + 1).is_ok() {
-            self.starts.push(0);
-            for i in 0..n {
-                total += op.pair_count(i);
-                self.starts.push(total);
-            }
+        self.starts.push(0);
+        for i in 0..n {
+            total += op.pair_count(i);
+            self.starts.push(total);
         }
-        if self.starts.len() == n + 1 && self.couplings.try_reserve(total).is_ok() {
+        if self.couplings.try_reserve(total).is_ok() {
             // In order, within the capacity just reserved.
             for i in 0..n {
                 op.coupled(i, |c, _, _| self.couplings.push(c));

@@ -351,8 +351,7 @@ typedef struct PfParams {
      * a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
      * no world, where it cannot be had; `pf_params_validate` checks only the value. A world
      * on the GPU refuses bodies, walls built as fields and solvers other than
-     * `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only with
-     * `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+     * `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default `PF_BACKEND_CPU`.
      */
     uint32_t backend;
     /**
@@ -540,7 +539,7 @@ enum PfStatus pf_params_calm(struct PfParams *params);
  * Checks `*params` without creating a world: `PF_OK` when every field holds a valid value,
  * otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field. Whether
  * `backend = PF_BACKEND_GPU` can be had (the library's `gpu` feature, a Vulkan adapter, a
- * solver and viscosity the GPU runs) is known only when `pf_world_create` opens it.
+ * solver the GPU runs) is known only when `pf_world_create` opens it.
  *
  * # Safety
  * `params` must be NULL or point to a readable `PfParams`.
@@ -588,8 +587,7 @@ uint32_t pf_abi_version(void);
  * Errors: `PF_ERROR_NULL_POINTER` (params or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a bad
  * parameter, named in the message; and for the GPU, a message starting `backend gpu: `
  * that says what is missing: `not available: this build of projfluid has no `gpu`
- * feature`, no Vulkan adapter, or a solver or `kinematic_viscosity` the GPU backend does
- * not run). No world is made then; there is no fallback to the CPU.
+ * feature`, no Vulkan adapter, or a solver the GPU backend does not run). No world is made then; there is no fallback to the CPU.
  *
  * # Safety
  * `params` must be NULL or point to a readable `PfParams`; `out` must be NULL or point to a writable `PfWorld*`.
@@ -930,9 +928,7 @@ enum PfStatus pf_world_get_material_rest_density(const struct PfWorld *world,
  *
  * Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
  * the world does not have, the message giving the valid range; a viscosity that is
- * negative or not finite; a viscosity above 0 in a world that steps on the GPU, which does
- * not run the viscosity solve, the message starting "backend gpu"). On any error nothing
- * changes. Thread safety: one thread at a time per world.
+ * negative or not finite). On any error nothing changes. Thread safety: one thread at a time per world.
  *
  * # Safety
  * `world` must be NULL or a live handle from `pf_world_create`.

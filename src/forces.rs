@@ -12,7 +12,7 @@ use viscosity::Viscosity;
 use vorticity::VorticityConfinement;
 use xsph::Xsph;
 
-mod viscosity;
+pub(crate) mod viscosity;
 mod vorticity;
 mod xsph;
 

@@ -2,6 +2,10 @@
 //! Its flow against the analytic duct flow is tested with `projfluid validate poiseuille`'s
 //! code, in cli/tests/validation.rs.
 
+#[path = "support/honey.rs"]
+mod honey;
+
+use honey::{fronts, honey_beside_water};
 use projfluid::{Material, Params, Vec3, World};
 
 /// A ball of `n`³ particles without gravity or walls, spinning at `omega` (rad/s) about the
@@ -199,51 +203,10 @@ fn a_material_viscosity_acts_as_the_parameter_does() {
 #[test]
 fn honey_beside_water_runs_more_slowly() {
     let run = |honey_nu: f64| {
-        let params = Params::default();
-        let (r, d) = (params.particle_radius, params.spacing());
-        let mut world = World::new(params).unwrap();
-        let (gap, length) = (0.25 * r, 3.0);
-        world
-            .add_container(
-                projfluid::boundary::Aabb {
-                    min: Vec3::repeat(-gap),
-                    max: Vec3::new(length + gap, 1.2 + gap, 8.0 * d + gap),
-                },
-                1,
-            )
-            .unwrap();
-        world
-            .add_fluid_block(Vec3::repeat(r), [8, 16, 8], Vec3::zeros())
-            .unwrap();
-        let honey = world
-            .add_material(Material {
-                rest_density: 1420.0,
-                kinematic_viscosity: honey_nu,
-            })
-            .unwrap();
-        world.set_fluid_material(honey).unwrap();
-        let far = Vec3::new(length - r - 7.0 * d, r, r);
-        world
-            .add_fluid_block(far, [8, 16, 8], Vec3::zeros())
-            .unwrap();
+        let (mut world, honey) = honey_beside_water(honey_nu);
         world.advance(0.4).unwrap();
         assert_eq!(world.escaped_count(), 0);
-        let materials = world.particle_materials();
-        let x: Vec<f64> = world.positions().iter().map(|p| p.x).collect();
-        let run_of = |m: u16, reach: &dyn Fn(f64) -> f64| {
-            let mut run: Vec<f64> = x
-                .iter()
-                .zip(&materials)
-                .filter(|(_, k)| **k == m)
-                .map(|(&x, _)| reach(x))
-                .collect();
-            run.sort_by(f64::total_cmp);
-            run[run.len() * 99 / 100]
-        };
-        let start = 8.0 * d;
-        let water = run_of(0, &|x| x) - start;
-        let honey = run_of(honey, &|x| length - x) - start;
-        (water, honey)
+        fronts(&world, honey)
     };
     let (water, honey) = run(0.1);
     assert!(water > 2.0 * honey, "water {water} m, honey {honey} m");

@@ -156,8 +156,7 @@ pub struct PfParams {
     /// a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
     /// no world, where it cannot be had; `pf_params_validate` checks only the value. A world
     /// on the GPU refuses bodies, walls built as fields and solvers other than
-    /// `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`, and is made only with
-    /// `kinematic_viscosity` 0. Default `PF_BACKEND_CPU`.
+    /// `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default `PF_BACKEND_CPU`.
     pub backend: u32,
     /// Vorticity confinement coefficient ε in [0, 10] (dimensionless; 0 = off): an
     /// acceleration ε·H·|ω|·(N × ω) that gives back rotation the solver and XSPH damp
@@ -363,7 +362,7 @@ pub unsafe extern "C" fn pf_params_calm(params: *mut PfParams) -> PfStatus {
 /// Checks `*params` without creating a world: `PF_OK` when every field holds a valid value,
 /// otherwise `PF_ERROR_INVALID_ARGUMENT` with a message naming the first bad field. Whether
 /// `backend = PF_BACKEND_GPU` can be had (the library's `gpu` feature, a Vulkan adapter, a
-/// solver and viscosity the GPU runs) is known only when `pf_world_create` opens it.
+/// solver the GPU runs) is known only when `pf_world_create` opens it.
 ///
 /// # Safety
 /// `params` must be NULL or point to a readable `PfParams`.

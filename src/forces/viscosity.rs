@@ -18,20 +18,20 @@ use rayon::prelude::*;
 use std::collections::TryReserveError;
 
 /// 2(d + 2) for d = 3 dimensions.
-const LAPLACIAN_FACTOR: f64 = 10.0;
+pub(crate) const LAPLACIAN_FACTOR: f64 = 10.0;
 
 /// The regularisation of |x_ij|² in the Laplacian, in H².
-const REGULARISATION: f64 = 0.01;
+pub(crate) const REGULARISATION: f64 = 0.01;
 
 /// The relative residual ‖r‖ ≤ tolerance·‖b‖ at which a solve stops.
-const TOLERANCE: f64 = 1e-4;
+pub(crate) const TOLERANCE: f64 = 1e-4;
 
 /// The largest calibration κ_i: a particle with few neighbours (a splash) is not coupled
 /// more strongly than this many times the uncalibrated operator would couple it.
-const MOST_CALIBRATION: f64 = 3.0;
+pub(crate) const MOST_CALIBRATION: f64 = 3.0;
 
 /// The most conjugate-gradient iterations of one solve.
-const MAX_ITERATIONS: usize = 200;
+pub(crate) const MAX_ITERATIONS: usize = 200;
 
 /// The implicit viscosity solve, each particle of its material's kinematic viscosity, and
 /// its buffers.

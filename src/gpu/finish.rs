@@ -1,6 +1,7 @@
 //! The end of a step on the device (docs/method.md §1.3 steps 5–8; shaders/finish.wgsl):
-//! velocities from the positions, the new positions, the densities at them, the vorticity
-//! confinement where it is on (§15, shaders/vorticity.wgsl), the XSPH filter, and the
+//! velocities from the positions, the new positions, the densities at them, then (after the
+//! physical viscosity where a material has one, viscosity.rs) the vorticity confinement
+//! where it is on (§15, shaders/vorticity.wgsl), the XSPH filter, and the
 //! per-particle values of the step's density errors and of the CFL rule, reduced after
 //! (reduce.rs). The CFL rule itself is [`next_step_size`].
 
@@ -94,20 +95,35 @@ impl Finish {
         }
     }
 
-    /// Records the update from the result in `b.iterates[result]`, the vorticity
+    /// Records the update from the result in `b.iterates[result]`: the velocities from the
+    /// positions, the new positions and the densities at them.
+    pub fn record_update(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        dispatch(
+            &mut pass,
+            &self.kernel.pipelines[0],
+            &self.groups[result],
+            b.n,
+        );
+    }
+
+    /// Records what follows the update and the physical viscosity: the vorticity
     /// confinement where it is on and the XSPH filter, whose velocities are copied back
     /// into `b.v`.
-    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
+    pub fn record_filters(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
-            let group = &self.groups[result];
-            dispatch(&mut pass, &self.kernel.pipelines[0], group, b.n);
             if let Some(v) = &self.vorticity {
                 let confine = v.group.as_ref().expect("Finish::bind runs before a step");
                 dispatch(&mut pass, &v.kernel.pipelines[0], confine, b.n);
                 dispatch(&mut pass, &v.kernel.pipelines[1], confine, b.n);
             }
-            dispatch(&mut pass, &self.kernel.pipelines[1], group, b.n);
+            dispatch(
+                &mut pass,
+                &self.kernel.pipelines[1],
+                &self.groups[result],
+                b.n,
+            );
         }
         encoder.copy_buffer_to_buffer(&b.v_out, 0, &b.v, 0, u64::from(b.n) * 16);
     }

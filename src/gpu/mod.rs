@@ -9,11 +9,11 @@
 //! by index), sums in a fixed tree, and every per-particle sum gathered by the particle
 //! itself in the order of its neighbour list.
 //!
-//! It steps worlds without bodies, walls built as fields and the physical viscosity, with
-//! Chebyshev's solver or one Jacobi sweep (without the warm start and the coarse
-//! correction, stepper.rs): the fluid and the static boundary as particles, with several
-//! materials (their mass ratios dividing the projection weights, §14), vorticity
-//! confinement (§15) and XSPH. Emitters, sinks and the domain (§12) act on the host between
+//! It steps worlds without bodies and walls built as fields, with Chebyshev's solver or one
+//! Jacobi sweep (without the warm start and the coarse correction, stepper.rs): the fluid
+//! and the static boundary as particles, with several materials (their mass ratios dividing
+//! the projection weights, §14), the physical viscosity (§13), vorticity confinement (§15)
+//! and XSPH. Emitters, sinks and the domain (§12) act on the host between
 //! steps; where they change the number of particles the stepper is remade on the same
 //! device, its kernels kept.
 //!
@@ -21,7 +21,8 @@
 //! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists), [`local`]
 //! (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`] (the
 //! reductions of the stopping rules and statistics), [`finish`] (velocities, densities,
-//! vorticity confinement, XSPH, CFL) and [`stepper`] (the step in order). Shaders are in
+//! vorticity confinement, XSPH, CFL), [`viscosity`] (the physical viscosity's solve) and
+//! [`stepper`] (the step in order). Shaders are in
 //! `shaders/`.
 
 /// A shader's WGSL source with shaders/common.wgsl (the step's constants, the kernel, the
@@ -45,6 +46,7 @@ mod reduce;
 mod scan;
 mod search;
 mod stepper;
+mod viscosity;
 
 pub(crate) use context::check_limits;
 pub(crate) use stepper::{GpuStepper, Scene};

@@ -19,6 +19,7 @@ use super::global::GlobalStep;
 use super::local::LocalStep;
 use super::reduce::Reduction;
 use super::search::Search;
+use super::viscosity::ViscositySolve;
 use crate::boundary::Aabb;
 use crate::material::MaterialId;
 use crate::params::{Params, ProjectionWeight, SolverKind};
@@ -105,6 +106,7 @@ impl GpuStepper {
             local: LocalStep::new(&ctx),
             global: GlobalStep::new(&ctx),
             finish: Finish::new(&ctx, confine),
+            viscosity: None,
         };
         let reduce = Reduction::compile(&ctx);
         let chebyshev = Chebyshev::new(scene.params.chebyshev);
@@ -184,6 +186,9 @@ impl GpuStepper {
         self.stages.local.bind(ctx, b);
         self.stages.global.bind(ctx, b);
         self.stages.finish.bind(ctx, b);
+        if let Some(viscosity) = &mut self.stages.viscosity {
+            viscosity.bind(ctx, b, &self.reduction);
+        }
     }
 
     /// Replaces the fluid's positions (m), velocities (m/s) and materials, as many as the
@@ -260,17 +265,24 @@ impl GpuStepper {
         })
     }
 
-    /// Advances the fluid by one step of `dt` seconds; returns what the step did and the
-    /// size of the next step by the CFL rule (s). Errors when the device fails; the
-    /// fluid's state on the device is then undefined.
-    pub fn step(&mut self, dt: f64) -> Result<(StepStats, f64), Error> {
+    /// Advances the fluid by one step of `dt` seconds, each material k of the kinematic
+    /// viscosity `viscosities[k]` (m²/s; the physical viscosity is solved where one is
+    /// positive); returns what the step did and the size of the next step by the CFL rule
+    /// (s). Errors when the device fails; the fluid's state on the device is then undefined.
+    pub fn step(&mut self, dt: f64, viscosities: &[f64]) -> Result<(StepStats, f64), Error> {
         let scope = self.ctx.scope();
-        let taken = self.advance(dt);
+        let taken = self.advance(dt, viscosities);
         scope.close(taken)
     }
 
     /// [`GpuStepper::step`] within its error scopes.
-    fn advance(&mut self, dt: f64) -> Result<(StepStats, f64), Error> {
+    fn advance(&mut self, dt: f64, viscosities: &[f64]) -> Result<(StepStats, f64), Error> {
+        let viscous = viscosities.iter().any(|&nu| nu > 0.0);
+        if viscous && self.stages.viscosity.is_none() {
+            let mut solve = ViscositySolve::new(&self.ctx, &self.params);
+            solve.bind(&self.ctx, &self.buffers, &self.reduction);
+            self.stages.viscosity = Some(solve);
+        }
         let started = Instant::now();
         let params = &self.params;
         let mut constants = self.constants;
@@ -313,7 +325,17 @@ impl GpuStepper {
             .queue
             .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
         let mut encoder = self.ctx.encoder();
-        self.stages.finish.record(&mut encoder, b, outcome.result);
+        self.stages
+            .finish
+            .record_update(&mut encoder, b, outcome.result);
+        if let Some(solve) = self.stages.viscosity.as_ref().filter(|_| viscous) {
+            self.ctx.queue.submit([encoder.finish()]);
+            solve.solve(&self.ctx, b, &self.reduction, viscosities, dt)?;
+            encoder = self.ctx.encoder();
+        }
+        self.stages
+            .finish
+            .record_filters(&mut encoder, b, outcome.result);
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             self.reduction.record(&mut pass);
@@ -438,6 +460,8 @@ struct Stages {
     local: LocalStep,
     global: GlobalStep,
     finish: Finish,
+    /// The physical viscosity's solve, compiled at the first step that needs it.
+    viscosity: Option<ViscositySolve>,
 }
 
 /// The number of fluid particles of `scene` on the device. Errors when the fluid or the

@@ -17,8 +17,8 @@ pub enum Backend {
     #[default]
     Cpu,
     /// A graphics card through Vulkan compute shaders, in single precision (feature `gpu`),
-    /// with several materials, vorticity confinement, emitters, sinks and the domain as on
-    /// the CPU. Not yet with bodies, walls built as fields or the physical viscosity; the
+    /// with several materials, the physical viscosity, vorticity confinement, emitters, sinks
+    /// and the domain as on the CPU. Not yet with bodies or walls built as fields; the
     /// solver is Chebyshev's or one Jacobi sweep. The warm start and the coarse correction are left out on it
     /// (docs/method.md §4.1, §3.8).
     Gpu,
@@ -143,9 +143,6 @@ impl World {
         if !self.boundary.walls.is_empty() {
             return refuse("container walls built as fields");
         }
-        if self.materials.viscous() {
-            return refuse("the physical viscosity (kinematic_viscosity)");
-        }
         Ok(())
     }
 
@@ -210,7 +207,7 @@ impl World {
         }
         let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
         let stepper = slot.context.as_mut().expect("made above");
-        let (stats, next_dt) = stepper.step(dt)?;
+        let (stats, next_dt) = stepper.step(dt, &self.materials.viscosities)?;
         let back = stepper.read()?;
         let fluid = &mut self.fluid;
         // The device's order: every per-particle array the world keeps follows it (the

@@ -14,11 +14,8 @@ impl World {
     /// world's, or on more than [`crate::material::MAX_MATERIALS`] materials.
     ///
     /// A material with a kinematic viscosity brings the implicit viscosity solve into the
-    /// step (docs/method.md §13), which the GPU backend refuses.
+    /// step (docs/method.md §13), on either backend.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
-        if material.kinematic_viscosity > 0.0 {
-            self.refuse_on_gpu("the physical viscosity (kinematic_viscosity)")?;
-        }
         let id = self.materials.add(material, self.params.rest_density)?;
         self.update_forces();
         Ok(id)
@@ -26,16 +23,13 @@ impl World {
 
     /// Sets the kinematic viscosity ν (m²/s) of material `id` (0 is the world's own fluid,
     /// whose [`crate::Params::kinematic_viscosity`] follows), from the next step on. Errors,
-    /// changing nothing, on an id the world has no material for, a viscosity that is negative
-    /// or not finite, or a viscosity on a world that steps on the GPU.
+    /// changing nothing, on an id the world has no material for or a viscosity that is
+    /// negative or not finite.
     pub fn set_material_kinematic_viscosity(
         &mut self,
         id: MaterialId,
         nu: f64,
     ) -> Result<(), Error> {
-        if nu > 0.0 {
-            self.refuse_on_gpu("the physical viscosity (kinematic_viscosity)")?;
-        }
         self.materials.set_viscosity(id, nu)?;
         if id == 0 {
             self.params.kinematic_viscosity = nu;

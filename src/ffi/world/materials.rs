@@ -160,9 +160,7 @@ pub unsafe extern "C" fn pf_world_get_material_rest_density(
 ///
 /// Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
 /// the world does not have, the message giving the valid range; a viscosity that is
-/// negative or not finite; a viscosity above 0 in a world that steps on the GPU, which does
-/// not run the viscosity solve, the message starting "backend gpu"). On any error nothing
-/// changes. Thread safety: one thread at a time per world.
+/// negative or not finite). On any error nothing changes. Thread safety: one thread at a time per world.
 ///
 /// # Safety
 /// `world` must be NULL or a live handle from `pf_world_create`.

@@ -120,8 +120,7 @@ const _: fn() = || {
 /// Errors: `PF_ERROR_NULL_POINTER` (params or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a bad
 /// parameter, named in the message; and for the GPU, a message starting `backend gpu: `
 /// that says what is missing: `not available: this build of projfluid has no `gpu`
-/// feature`, no Vulkan adapter, or a solver or `kinematic_viscosity` the GPU backend does
-/// not run). No world is made then; there is no fallback to the CPU.
+/// feature`, no Vulkan adapter, or a solver the GPU backend does not run). No world is made then; there is no fallback to the CPU.
 ///
 /// # Safety
 /// `params` must be NULL or point to a readable `PfParams`; `out` must be NULL or point to a writable `PfWorld*`.

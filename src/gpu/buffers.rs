@@ -17,8 +17,15 @@ const MAX_CELLS: f64 = (1u64 << 24) as f64;
 /// Cells are this much wider than H, so that rounding never puts two particles within H
 /// of each other two cells apart.
 const CELL_SLACK: f64 = 1.0 + 1e-4;
-/// The neighbour lists are grown to this multiple of what a step needs.
+/// The neighbour lists and the pool of kept corrections are grown to this multiple of what
+/// a step needs.
 const LIST_GROWTH: f64 = 1.25;
+/// Entries the pool of kept corrections starts with: one (a binding of it holds one at
+/// least), as few projections take more than one step (shaders/project.wgsl); the pool
+/// grows to what the local steps ask for.
+const INITIAL_POOL: u64 = 1;
+/// The pool's header (cursor and overflow flag), in vec4 slots.
+const POOL_HEADER: u64 = 1;
 
 /// Entries of the material table in [`StepParams`] (`inverse_ratio` in shaders/common.wgsl):
 /// one for every material a world can hold.
@@ -171,11 +178,13 @@ pub(super) struct Buffers {
     pub boundary_offset: wgpu::Buffer,
     pub fluid_list: wgpu::Buffer,
     pub boundary_list: wgpu::Buffer,
-    /// Kept corrections of multi-step projections: n + fluid list entries (m).
+    /// The pool of kept corrections of multi-step projections (`Pool` in
+    /// shaders/common.wgsl): a header, then the entries (m).
     pub kept: wgpu::Buffer,
-    /// Entries the lists have room for.
+    /// Entries the lists and the pool have room for.
     pub fluid_room: u64,
     pub boundary_room: u64,
+    pub kept_room: u64,
     /// X^(k) and X^(k−1), exchanging roles every outer iteration (m).
     pub iterates: [wgpu::Buffer; 2],
     /// The local step's own correction and λ, ρ_i (kg/m³) and multi-step flag.
@@ -239,9 +248,10 @@ impl Buffers {
             boundary_offset: word("boundary_offset", particles + 1),
             fluid_list: word("fluid_list", fluid_room),
             boundary_list: word("boundary_list", boundary_room),
-            kept: ctx.storage("kept", (particles + fluid_room) * VEC4),
+            kept: ctx.storage("kept", (POOL_HEADER + INITIAL_POOL) * VEC4),
             fluid_room,
             boundary_room,
+            kept_room: INITIAL_POOL,
             iterates: [vec4("iterate_a"), vec4("iterate_b")],
             projection: vec4("projection"),
             density: word("density", particles),
@@ -268,8 +278,6 @@ impl Buffers {
         if fluid > self.fluid_room {
             self.fluid_room = (fluid as f64 * LIST_GROWTH) as u64;
             self.fluid_list = ctx.storage("fluid_list", self.fluid_room * WORD);
-            let slots = u64::from(self.n) + self.fluid_room;
-            self.kept = ctx.storage("kept", slots * VEC4);
             grown = true;
         }
         if boundary > self.boundary_room {
@@ -278,5 +286,17 @@ impl Buffers {
             grown = true;
         }
         grown
+    }
+
+    /// Makes the pool of kept corrections room for `entries` entries, which a local step
+    /// asked for; the bind groups that hold it must then be made again.
+    pub fn grow_pool(&mut self, ctx: &Context, entries: u64) {
+        self.kept_room = ((entries as f64 * LIST_GROWTH) as u64).max(INITIAL_POOL);
+        self.kept = ctx.storage("kept", (POOL_HEADER + self.kept_room) * VEC4);
+    }
+
+    /// Records the reset of the pool's cursor and overflow flag, before a local step.
+    pub fn clear_pool(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.kept, 0, Some(POOL_HEADER * VEC4));
     }
 }

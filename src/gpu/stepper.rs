@@ -356,6 +356,39 @@ impl GpuStepper {
         Ok((stats, next_step_size(&self.params, f64::from(fastest))))
     }
 
+    /// One outer iteration's local and global steps from X^(k) in `b.iterates[current]`, and
+    /// their reduction read back (Σ compression, largest move). Where the local step found
+    /// the pool of kept corrections full, the global step wrote nothing (shaders/sweep.wgsl):
+    /// the pool is grown to what the local step asked for and the iteration taken again,
+    /// to the same bits. Errors when the device fails or the pool cannot grow.
+    fn local_and_global(&mut self, current: usize) -> Result<[f32; 4], Error> {
+        for attempt in 0..2 {
+            let b = &self.buffers;
+            let mut encoder = self.ctx.encoder();
+            b.clear_pool(&mut encoder);
+            {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.stages.local.record(&mut pass, b, current);
+                self.stages.global.record(&mut pass, b, current);
+                self.reduction.record(&mut pass);
+            }
+            let reduced = self.reduction.read(&self.ctx, encoder)?;
+            if reduced[3] == 0.0 {
+                return Ok(reduced);
+            }
+            if attempt == 0 {
+                // The pool's cursor: the entries the local step asked for.
+                let cursor = words(&self.ctx.read(self.ctx.encoder(), &b.kept, 4)?)[0];
+                self.buffers.grow_pool(&self.ctx, u64::from(cursor));
+                self.bind();
+            }
+        }
+        Err(Error::OutOfMemory(format!(
+            "the GPU {} could not make room for the kept corrections of the local step",
+            self.ctx.adapter
+        )))
+    }
+
     /// Records X^(0) = X^(−1) = s.
     fn start_from_prediction(&self, encoder: &mut wgpu::CommandEncoder) {
         let b = &self.buffers;
@@ -371,7 +404,7 @@ impl GpuStepper {
     /// steps of one outer iteration go to the device together and their reductions are
     /// read back once.
     fn iterate(&mut self) -> Result<Outcome, Error> {
-        let params = &self.params;
+        let params = &self.params.clone();
         let n = f64::from(self.buffers.n.max(1));
         self.chebyshev.reset();
         self.displacements.clear();
@@ -409,18 +442,10 @@ impl GpuStepper {
                 extrapolate: u32::from(accelerate && self.chebyshev.changes(omega)),
                 densities_known: 0,
             };
-            let b = &self.buffers;
             self.ctx
                 .queue
-                .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
-            let mut encoder = self.ctx.encoder();
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.stages.local.record(&mut pass, b, current);
-                self.stages.global.record(&mut pass, b, current);
-                self.reduction.record(&mut pass);
-            }
-            let [compression, moved, _, _] = self.reduction.read(&self.ctx, encoder)?;
+                .write_buffer(&self.buffers.iter, 0, bytemuck::bytes_of(&iter));
+            let [compression, moved, _, _] = self.local_and_global(current)?;
             // The density rule at X^(k), with the motion of the iteration before; the
             // global step taken with it is then dropped.
             if k >= params.min_outer_iterations

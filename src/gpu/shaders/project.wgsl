@@ -1,9 +1,13 @@
 // The local step (docs/method.md §2.5): every active density constraint projected on a
 // private copy p of its stencil by Newton-like steps, as src/constraint/projection.rs does.
 // A projection that ends after its first step is kept as λ_i alone (the gather recomputes
-// its corrections); a longer one writes its stencil's corrections P_{i,j} − x_j into its
-// segment of `kept` (own correction first, then one per fluid neighbour in list order) and
-// is flagged. ρ_i at the iterate goes to `density`, max(ρ_i/ρ0 − 1, 0) to values.x for the
+// its corrections); a longer one takes a segment of the pool `kept`, writes its stencil's
+// corrections P_{i,j} − x_j there (own correction first, then one per fluid neighbour in list
+// order) and flags itself with the segment's start + 1. Few projections take more than one
+// step, so the pool holds far fewer entries than the lists: a segment is taken with an
+// atomic cursor (where it lies does not change what it holds), and a projection that finds
+// the pool full sets its overflow flag and stops; the host then grows the pool and takes
+// the outer iteration again, which the global step leaves undone (sweep.wgsl). ρ_i at the iterate goes to `density`, max(ρ_i/ρ0 − 1, 0) to values.x for the
 // density rule (§4). The constraint is the same for every material (its densities are in the
 // world's fluid's terms, §14); a particle's material enters through its weight alone.
 
@@ -17,7 +21,7 @@
 @group(0) @binding(7) var<storage, read_write> projection: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> density: array<f32>;
 @group(0) @binding(9) var<storage, read_write> flags: array<u32>;
-@group(0) @binding(10) var<storage, read_write> kept: array<vec4<f32>>;
+@group(0) @binding(10) var<storage, read_write> kept: Pool;
 @group(0) @binding(11) var<storage, read_write> values: array<vec4<f32>>;
 @group(0) @binding(12) var<storage, read_write> material: array<u32>;
 
@@ -42,7 +46,7 @@ fn member_offset(i: u32, e: u32, s: u32, mode: u32, lambda: f32, seg: u32) -> ve
         return g * (lambda * weight_of(j));
     }
     if mode == 2u {
-        return kept[seg + 1u + s].xyz;
+        return kept.entries[seg + 1u + s].xyz;
     }
     return vec3<f32>(0.0);
 }
@@ -104,8 +108,8 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
     let xi = x[i].xyz;
     let first = fluid_offset[i];
     let members = fluid_offset[i + 1u] - first;
-    // Segment of i in `kept`: its own correction, then one per neighbour.
-    let seg = first + i;
+    // Segment of i in the pool, once taken: its own correction, then one per neighbour.
+    var seg = 0u;
     let w_i = weight(members, material[i]);
     var own = vec3<f32>(0.0);
     var first_lambda = 0.0;
@@ -123,10 +127,16 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
         }
         let c = max(rho / P.rest_density - 1.0, 0.0);
         if step > 0u && !materialized && c > CONSTRAINT_GOAL {
-            // A second step is needed: the first step's corrections are written out.
-            kept[seg] = vec4<f32>(own, 0.0);
+            // A second step is needed: the first step's corrections are written out, into a
+            // segment of the pool.
+            seg = atomicAdd(&kept.cursor, members + 1u);
+            if seg + members + 1u > arrayLength(&kept.entries) {
+                atomicStore(&kept.overflow, 1u);
+                break;
+            }
+            kept.entries[seg] = vec4<f32>(own, 0.0);
             for (var e = first; e < first + members; e++) {
-                kept[seg + 1u + e - first] = vec4<f32>(member_offset(i, e, e - first, 1u, first_lambda, seg), 0.0);
+                kept.entries[seg + 1u + e - first] = vec4<f32>(member_offset(i, e, e - first, 1u, first_lambda, seg), 0.0);
             }
             materialized = true;
             mode = 2u;
@@ -152,18 +162,18 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
             for (var e = first; e < first + members; e++) {
                 let j = fluid_list[e];
                 let slot = seg + 1u + e - first;
-                let pj = x[j].xyz + kept[slot].xyz;
+                let pj = x[j].xyz + kept.entries[slot].xyz;
                 let gj = -grad_w(pi - pj) * scale;
-                kept[slot] = vec4<f32>(kept[slot].xyz + gj * (lambda * weight_of(j)), 0.0);
+                kept.entries[slot] = vec4<f32>(kept.entries[slot].xyz + gj * (lambda * weight_of(j)), 0.0);
             }
         } else {
             first_lambda = lambda;
         }
         own += g.own * (lambda * w_i);
         if materialized {
-            kept[seg] = vec4<f32>(own, 0.0);
+            kept.entries[seg] = vec4<f32>(own, 0.0);
         }
     }
     projection[i] = vec4<f32>(own, first_lambda);
-    flags[i] = select(0u, 1u, materialized);
+    flags[i] = select(0u, seg + 1u, materialized);
 }

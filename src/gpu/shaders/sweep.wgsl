@@ -1,7 +1,9 @@
 // The global step on the diagonal system (docs/method.md §3.1, §3.6) fused with the gather
 // of the local step's corrections and Chebyshev's extrapolation (§3.7), as
 // src/solver/sweep.rs: X^(k+1) replaces X^(k−1) in place, and |X^(k+1) − X^(k)| goes to
-// values.y for the displacement rule (§4).
+// values.y for the displacement rule (§4). Where the local step found its pool of kept
+// corrections full (project.wgsl), nothing is written but values.w = 1, which tells the
+// host to grow the pool and take the outer iteration again.
 
 struct IterParams {
     // ω of this outer iteration, Chebyshev's γ, whether to extrapolate (0/1), whether the
@@ -21,7 +23,7 @@ struct IterParams {
 @group(0) @binding(6) var<storage, read_write> fluid_list: array<u32>;
 @group(0) @binding(7) var<storage, read_write> projection: array<vec4<f32>>;
 @group(0) @binding(8) var<storage, read_write> flags: array<u32>;
-@group(0) @binding(9) var<storage, read_write> kept: array<vec4<f32>>;
+@group(0) @binding(9) var<storage, read_write> kept: Pool;
 @group(0) @binding(10) var<storage, read_write> values: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> material: array<u32>;
 
@@ -47,11 +49,12 @@ fn gathered(j: u32, xj: vec3<f32>, count: u32) -> vec3<f32> {
         for (var e = first; e < first + count; e++) {
             let i = fluid_list[e];
             if flags[i] != 0u {
-                // j's place in i's list (the lists are symmetric), after i's own correction.
+                // j's place in i's list (the lists are symmetric), after i's own correction
+                // at the start of its segment (flags[i] − 1).
                 let start = fluid_offset[i];
                 for (var f = start; f < fluid_offset[i + 1u]; f++) {
                     if fluid_list[f] == j {
-                        sum += kept[start + i + 1u + f - start].xyz;
+                        sum += kept.entries[flags[i] + f - start].xyz;
                         break;
                     }
                 }
@@ -66,6 +69,10 @@ fn sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: ve
          @builtin(local_invocation_index) lid: u32) {
     let j = item(wid, nwg, lid);
     if j >= P.n {
+        return;
+    }
+    if atomicLoad(&kept.overflow) != 0u {
+        values[j].w = 1.0;
         return;
     }
     let x = current[j].xyz;

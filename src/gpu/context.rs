@@ -305,18 +305,37 @@ impl Context {
     /// buffer after the commands of `encoder` run.
     pub fn read(
         &self,
-        mut encoder: wgpu::CommandEncoder,
+        encoder: wgpu::CommandEncoder,
         source: &wgpu::Buffer,
         bytes: u64,
     ) -> Result<Vec<u8>, Error> {
-        let size = bytes.max(4).next_multiple_of(4);
+        let mut read = self.read_many(encoder, &[(source, bytes)])?;
+        Ok(read.pop().unwrap_or_default())
+    }
+
+    /// The first bytes of each of `sources` (buffer and byte count, a multiple of 4), copied
+    /// back through one staging buffer after the commands of `encoder` run: one wait on the
+    /// device for them all.
+    pub fn read_many(
+        &self,
+        mut encoder: wgpu::CommandEncoder,
+        sources: &[(&wgpu::Buffer, u64)],
+    ) -> Result<Vec<Vec<u8>>, Error> {
+        let sizes: Vec<u64> = sources
+            .iter()
+            .map(|&(_, bytes)| bytes.max(4).next_multiple_of(4))
+            .collect();
         let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("read-back"),
-            size,
+            size: sizes.iter().sum(),
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        encoder.copy_buffer_to_buffer(source, 0, &staging, 0, size);
+        let mut offset = 0;
+        for (&(source, _), &size) in sources.iter().zip(&sizes) {
+            encoder.copy_buffer_to_buffer(source, 0, &staging, offset, size);
+            offset += size;
+        }
         self.queue.submit([encoder.finish()]);
         let mapped = Arc::new(Mutex::new(None));
         let done = Arc::clone(&mapped);
@@ -342,7 +361,15 @@ impl Context {
             .map_err(|e| gpu_error(&format!("could not map a read-back: {e}")))?
             .to_vec();
         staging.unmap();
-        Ok(bytes[..bytes.len().min(size as usize)].to_vec())
+        let mut start = 0;
+        Ok(sizes
+            .iter()
+            .map(|&size| {
+                let part = bytes[start as usize..(start + size) as usize].to_vec();
+                start += size;
+                part
+            })
+            .collect())
     }
 }
 

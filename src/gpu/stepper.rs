@@ -246,10 +246,17 @@ impl GpuStepper {
     fn read_back(&self) -> Result<Readback, Error> {
         let b = &self.buffers;
         let n = u64::from(b.n);
-        let x = floats(&self.ctx.read(self.ctx.encoder(), &b.x, n * 16)?);
-        let v = floats(&self.ctx.read(self.ctx.encoder(), &b.v, n * 16)?);
-        let densities = floats(&self.ctx.read(self.ctx.encoder(), &b.density, n * 4)?);
-        let order = words(&self.ctx.read(self.ctx.encoder(), &b.ids, n * 4)?);
+        let sources = [
+            (&b.x, n * 16),
+            (&b.v, n * 16),
+            (&b.density, n * 4),
+            (&b.ids, n * 4),
+        ];
+        let [x, v, densities, order] = &self.ctx.read_many(self.ctx.encoder(), &sources)?[..]
+        else {
+            unreachable!("four buffers were read");
+        };
+        let (x, v, densities, order) = (floats(x), floats(v), floats(densities), words(order));
         let grid = &self.grid;
         Ok(Readback {
             positions: x

@@ -193,6 +193,10 @@ pub(super) struct Buffers {
     pub flags: wgpu::Buffer,
     /// Per particle values to reduce (reduce.wgsl).
     pub values: wgpu::Buffer,
+    /// ω_k and whether to extrapolate of every outer iteration, and where the outer
+    /// iteration stands with its displacements (shaders/control.wgsl).
+    pub schedule: wgpu::Buffer,
+    pub control: wgpu::Buffer,
     /// Every particle's vorticity ω_i (1/s) and |ω_i| in w, where the vorticity confinement
     /// is on (shaders/vorticity.wgsl; 16 bytes otherwise).
     pub vorticity: wgpu::Buffer,
@@ -206,14 +210,16 @@ const WORD: u64 = 4;
 
 impl Buffers {
     /// The buffers for `n` fluid particles and the sorted boundary `boundary` (device
-    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells;
-    /// with room for the vorticities where `vorticity` (the confinement is on).
+    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells,
+    /// for outer iterations of at most `iterations` iterations; with room for the
+    /// vorticities where `vorticity` (the confinement is on).
     pub fn new(
         ctx: &Context,
         n: u32,
         cells: u32,
         boundary: &[[f32; 4]],
         boundary_start: &[u32],
+        iterations: u64,
         vorticity: bool,
     ) -> Self {
         let particles = u64::from(n);
@@ -257,6 +263,8 @@ impl Buffers {
             density: word("density", particles),
             flags: word("flags", particles),
             values: vec4("values"),
+            schedule: ctx.storage("schedule", iterations * VEC4),
+            control: ctx.storage("control", 2 * VEC4 + iterations * WORD),
             vorticity: ctx.storage("vorticity", if vorticity { particles * VEC4 } else { 0 }),
             params: ctx.uniform("params", &StepParams::zeroed()),
             iter: ctx.uniform("iter", &IterParams::default()),
@@ -295,8 +303,9 @@ impl Buffers {
         self.kept = ctx.storage("kept", (POOL_HEADER + self.kept_room) * VEC4);
     }
 
-    /// Records the reset of the pool's cursor and overflow flag, before a local step.
+    /// Records the reset of the pool's cursor and overflow flag (the first two words of its
+    /// header), before a local step.
     pub fn clear_pool(&self, encoder: &mut wgpu::CommandEncoder) {
-        encoder.clear_buffer(&self.kept, 0, Some(POOL_HEADER * VEC4));
+        encoder.clear_buffer(&self.kept, 0, Some(2 * WORD));
     }
 }

@@ -15,7 +15,7 @@ pub(super) struct GlobalStep {
 impl GlobalStep {
     pub fn new(ctx: &Context) -> Self {
         let mut slots = vec![Slot::Uniform, Slot::Uniform];
-        slots.extend([Slot::Storage; 10]);
+        slots.extend([Slot::Storage; 11]);
         let kernel = ctx.kernel(
             "sweep",
             with_common!("shaders/sweep.wgsl"),
@@ -47,6 +47,7 @@ impl GlobalStep {
                         &b.kept,
                         &b.values,
                         &b.material,
+                        &b.schedule,
                     ],
                 )
             })

@@ -1,8 +1,9 @@
 //! The GPU backend (feature `gpu`): the time step of a world's fluid and static boundary
 //! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §1.3),
-//! in single precision. The fluid stays on the device during a step; a step reads back one
-//! reduction per outer iteration (the stopping rules, §4) and one at its end (statistics and
-//! the CFL rule, §8).
+//! in single precision. The fluid stays on the device during a step; a step waits on the
+//! device once for the neighbour lists' size, once per four outer iterations, whose stopping
+//! rules (§4) the device applies itself, and once at its end (statistics and the CFL rule,
+//! §8).
 //!
 //! Deterministic on one device and driver: integer atomics only where their result does not
 //! depend on the order (counting particles per cell; each cell's particles are then sorted
@@ -18,19 +19,21 @@
 //! device, its kernels kept.
 //!
 //! One file per stage: [`context`] (device, kernels, read-backs), [`buffers`] (the state on
-//! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists), [`local`]
-//! (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`] (the
-//! reductions of the stopping rules and statistics), [`finish`] (velocities, densities,
-//! vorticity confinement, XSPH, CFL), [`viscosity`] (the physical viscosity's solve) and
-//! [`stepper`] (the step in order). Shaders are in
+//! the device), [`search`] and [`scan`] (the counting sort and the neighbour lists),
+//! [`local`] (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`]
+//! (the reductions of the stopping rules and statistics), [`control`] (the stopping rules),
+//! [`finish`] (velocities, densities, vorticity confinement, XSPH, CFL), [`viscosity`] (the
+//! physical viscosity's solve) and [`stepper`] (the step in order). Shaders are in
 //! `shaders/`.
 
 /// A shader's WGSL source with shaders/common.wgsl (the step's constants, the kernel, the
-/// grid) before it.
+/// grid) and shaders/pool.wgsl (the pool of kept corrections) before it.
 macro_rules! with_common {
     ($path:literal) => {
         concat!(
             include_str!("shaders/common.wgsl"),
+            "\n",
+            include_str!("shaders/pool.wgsl"),
             "\n",
             include_str!($path)
         )
@@ -39,6 +42,7 @@ macro_rules! with_common {
 
 mod buffers;
 mod context;
+mod control;
 mod finish;
 mod global;
 mod local;

@@ -1,8 +1,9 @@
 //! [`GpuStepper`]: one time step of a world's fluid and static boundary on the device
 //! (docs/method.md §1.3), stage by stage as src/step/ takes it on the CPU: the neighbour
 //! phase (search.rs), the outer iteration of local steps (local.rs) and global steps with
-//! Chebyshev's extrapolation (global.rs) until a stopping rule holds (§4, read back once
-//! per outer iteration through reduce.rs), and the end of the step (finish.rs).
+//! Chebyshev's extrapolation (global.rs) until a stopping rule holds (§4, applied on the
+//! device by control.rs, read back once per batch of outer iterations), and the end of the
+//! step (finish.rs).
 //!
 //! Several materials (§14) enter through the projection weights, as on the CPU: every slot
 //! holds its particle's material, permuted with it, and [`StepParams::inverse_ratio`] the
@@ -14,6 +15,7 @@
 
 use super::buffers::{Buffers, Grid, IterParams, MATERIAL_SLOTS, StepParams};
 use super::context::{Context, Kernel, floats, words};
+use super::control::{BATCH, Control, Stop};
 use super::finish::{Finish, next_step_size};
 use super::global::GlobalStep;
 use super::local::LocalStep;
@@ -27,10 +29,6 @@ use crate::solver::Chebyshev;
 use crate::stats::{StepStats, StepTimings};
 use crate::{Error, Vec3};
 use std::time::Instant;
-
-/// The density rule also waits until the last outer iteration moved no particle farther
-/// than this multiple of τ (as src/step/iterate.rs).
-const DENSITY_RULE_MOTION: f64 = 10.0;
 
 /// What a [`GpuStepper`] is made from: a world's fluid and static boundary and its settings.
 #[derive(Clone, Copy)]
@@ -74,10 +72,10 @@ pub(crate) struct GpuStepper {
     params: Params,
     constants: StepParams,
     chebyshev: Chebyshev,
-    /// δ_k of the outer iterations of the current step (m).
-    displacements: Vec<f64>,
     /// The host's copies of what [`GpuStepper::upload`] writes, kept between steps.
     staging: Staging,
+    /// Whether the schedule on the device is Chebyshev's and for which ρ (its bits).
+    schedule: Option<(bool, u64)>,
 }
 
 /// Per-particle values in device form on their way to the device: reused by every upload,
@@ -106,6 +104,7 @@ impl GpuStepper {
             local: LocalStep::new(&ctx),
             global: GlobalStep::new(&ctx),
             finish: Finish::new(&ctx, confine),
+            control: Control::new(&ctx),
             viscosity: None,
         };
         let reduce = Reduction::compile(&ctx);
@@ -155,7 +154,16 @@ impl GpuStepper {
         let (boundary, boundary_start) = sort_boundary(&grid, scene.boundary, scene.psi);
         let confine = params.vorticity_confinement > 0.0;
         let cells = grid.cells();
-        let buffers = Buffers::new(&ctx, n, cells, &boundary, &boundary_start, confine);
+        let iterations = params.max_outer_iterations as u64;
+        let buffers = Buffers::new(
+            &ctx,
+            n,
+            cells,
+            &boundary,
+            &boundary_start,
+            iterations,
+            confine,
+        );
         let constants = constants(&params, &grid, scene, boundary.len() as u32);
         let reduction = Reduction::new(&ctx, reduce, n, &buffers.values);
         let mut stepper = GpuStepper {
@@ -165,12 +173,14 @@ impl GpuStepper {
             params,
             constants,
             grid,
-            displacements: Vec::new(),
             staging: Staging::default(),
+            schedule: None,
             buffers,
             ctx,
         };
         stepper.bind();
+        let (ctx, b) = (&stepper.ctx, &stepper.buffers);
+        stepper.stages.control.set_rules(ctx, &stepper.params, b.n);
         stepper.upload(scene.positions, scene.velocities, scene.materials)?;
         Ok(stepper)
     }
@@ -186,6 +196,7 @@ impl GpuStepper {
         self.stages.local.bind(ctx, b);
         self.stages.global.bind(ctx, b);
         self.stages.finish.bind(ctx, b);
+        self.stages.control.bind(ctx, b, &self.reduction);
         if let Some(viscosity) = &mut self.stages.viscosity {
             viscosity.bind(ctx, b, &self.reduction);
         }
@@ -363,39 +374,6 @@ impl GpuStepper {
         Ok((stats, next_step_size(&self.params, f64::from(fastest))))
     }
 
-    /// One outer iteration's local and global steps from X^(k) in `b.iterates[current]`, and
-    /// their reduction read back (Σ compression, largest move). Where the local step found
-    /// the pool of kept corrections full, the global step wrote nothing (shaders/sweep.wgsl):
-    /// the pool is grown to what the local step asked for and the iteration taken again,
-    /// to the same bits. Errors when the device fails or the pool cannot grow.
-    fn local_and_global(&mut self, current: usize) -> Result<[f32; 4], Error> {
-        for attempt in 0..2 {
-            let b = &self.buffers;
-            let mut encoder = self.ctx.encoder();
-            b.clear_pool(&mut encoder);
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                self.stages.local.record(&mut pass, b, current);
-                self.stages.global.record(&mut pass, b, current);
-                self.reduction.record(&mut pass);
-            }
-            let reduced = self.reduction.read(&self.ctx, encoder)?;
-            if reduced[3] == 0.0 {
-                return Ok(reduced);
-            }
-            if attempt == 0 {
-                // The pool's cursor: the entries the local step asked for.
-                let cursor = words(&self.ctx.read(self.ctx.encoder(), &b.kept, 4)?)[0];
-                self.buffers.grow_pool(&self.ctx, u64::from(cursor));
-                self.bind();
-            }
-        }
-        Err(Error::OutOfMemory(format!(
-            "the GPU {} could not make room for the kept corrections of the local step",
-            self.ctx.adapter
-        )))
-    }
-
     /// Records X^(0) = X^(−1) = s.
     fn start_from_prediction(&self, encoder: &mut wgpu::CommandEncoder) {
         let b = &self.buffers;
@@ -407,82 +385,136 @@ impl GpuStepper {
     /// The outer iteration (docs/method.md §1.3 step 4, §4), as src/step/iterate.rs: from
     /// X^(0) = X^(−1) = s, a local step, the density rule, a global step with the
     /// extrapolation and the displacement rule, until a rule holds or K_max; a step whose
-    /// extrapolation reaches K_max starts over from s without it. The local and global
-    /// steps of one outer iteration go to the device together and their reductions are
-    /// read back once.
+    /// extrapolation reaches K_max starts over from s without it. Chebyshev's weights are
+    /// laid out for every k in advance, and [`BATCH`] outer iterations go to the device at
+    /// once, the device applying the rules after each (control.rs); the host reads back
+    /// where they stopped, grows the pool of kept corrections where a local step found it
+    /// full and takes that iteration again, and restarts for the fallback.
     fn iterate(&mut self) -> Result<Outcome, Error> {
-        let params = &self.params.clone();
-        let n = f64::from(self.buffers.n.max(1));
+        let params = self.params.clone();
+        let max = params.max_outer_iterations;
         self.chebyshev.reset();
-        self.displacements.clear();
         let mut accelerate = params.solver == SolverKind::Chebyshev;
         let rho = if accelerate {
             self.chebyshev.rho()
         } else {
             0.0
         };
-        let (mut outer, mut k, mut current) = (0, 0, 0);
-        let mut displacement = f64::INFINITY;
-        let (mut converged, mut densities_known) = (false, false);
-        let tolerance = params.displacement_tolerance;
-        loop {
-            if k == params.max_outer_iterations {
-                if !accelerate || params.min_outer_iterations >= params.max_outer_iterations {
-                    break;
+        self.write_schedule(accelerate);
+        let iter = IterParams {
+            gamma: params.chebyshev.gamma as f32,
+            ..IterParams::default()
+        };
+        let (ctx, b) = (&self.ctx, &self.buffers);
+        ctx.queue
+            .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
+        self.stages.control.start(ctx, b, 0);
+        // The next outer iteration to record, and the last whose pool was found full.
+        let (mut next, mut full_at) = (0, None);
+        let standing = loop {
+            let mut encoder = self.ctx.encoder();
+            let last = (next + BATCH).min(max);
+            for k in next..last {
+                self.record_outer_iteration(&mut encoder, k % 2);
+            }
+            let standing = self
+                .stages
+                .control
+                .read(&self.ctx, &self.buffers, encoder)?;
+            match standing.stop {
+                Stop::Going if last < max => next = last,
+                Stop::Going => {
+                    return Err(crate::world::gpu_error(
+                        "the outer iteration passed its most iterations on the device",
+                    ));
                 }
-                // docs/method.md §4, "Fallback".
-                let mut encoder = self.ctx.encoder();
-                self.start_from_prediction(&mut encoder);
-                self.ctx.queue.submit([encoder.finish()]);
-                self.chebyshev.finish_step(&self.displacements);
-                (accelerate, k, current, displacement) = (false, 0, 0, f64::INFINITY);
-                self.displacements.clear();
+                Stop::Converged => break standing,
+                Stop::PoolFull { entries } => {
+                    if full_at == Some(standing.k) {
+                        return Err(Error::OutOfMemory(format!(
+                            "the GPU {} could not make room for the kept corrections of \
+                             the local step",
+                            self.ctx.adapter
+                        )));
+                    }
+                    full_at = Some(standing.k);
+                    self.buffers.grow_pool(&self.ctx, entries);
+                    self.bind();
+                    self.stages
+                        .control
+                        .resume(&self.ctx, &self.buffers, standing.k);
+                    next = standing.k;
+                }
+                Stop::Exhausted => {
+                    if !accelerate || params.min_outer_iterations >= max {
+                        break standing;
+                    }
+                    // docs/method.md §4, "Fallback".
+                    let control = &self.stages.control;
+                    let displacements =
+                        control.displacements(&self.ctx, &self.buffers, standing.k)?;
+                    self.chebyshev.finish_step(&displacements);
+                    accelerate = false;
+                    self.write_schedule(accelerate);
+                    let mut encoder = self.ctx.encoder();
+                    self.start_from_prediction(&mut encoder);
+                    self.ctx.queue.submit([encoder.finish()]);
+                    self.stages
+                        .control
+                        .start(&self.ctx, &self.buffers, standing.outer);
+                    (next, full_at) = (0, None);
+                }
             }
-            let omega = if accelerate {
-                self.chebyshev.next_weight(k)
-            } else {
-                1.0
-            };
-            let iter = IterParams {
-                omega: omega as f32,
-                gamma: params.chebyshev.gamma as f32,
-                extrapolate: u32::from(accelerate && self.chebyshev.changes(omega)),
-                densities_known: 0,
-            };
-            self.ctx
-                .queue
-                .write_buffer(&self.buffers.iter, 0, bytemuck::bytes_of(&iter));
-            let [compression, moved, _, _] = self.local_and_global(current)?;
-            // The density rule at X^(k), with the motion of the iteration before; the
-            // global step taken with it is then dropped.
-            if k >= params.min_outer_iterations
-                && displacement < DENSITY_RULE_MOTION * tolerance
-                && f64::from(compression) / n <= params.density_tolerance
-            {
-                (converged, densities_known) = (true, true);
-                break;
-            }
-            displacement = f64::from(moved);
-            self.displacements.push(displacement);
-            current = 1 - current;
-            outer += 1;
-            k += 1;
-            if k >= params.min_outer_iterations && displacement < tolerance {
-                converged = true;
-                break;
-            }
-        }
+        };
         if accelerate {
-            self.chebyshev.finish_step(&self.displacements);
+            let control = &self.stages.control;
+            let displacements = control.displacements(&self.ctx, &self.buffers, standing.k)?;
+            self.chebyshev.finish_step(&displacements);
         }
         Ok(Outcome {
-            outer,
-            displacement,
+            outer: standing.outer,
+            displacement: standing.displacement,
             rho,
-            converged,
-            densities_known,
-            result: current,
+            converged: standing.stop == Stop::Converged,
+            densities_known: standing.densities_known,
+            result: standing.current,
         })
+    }
+
+    /// Writes the schedule of the outer iteration: Chebyshev's ω_k and whether to
+    /// extrapolate for every k where `accelerate`, else plain iterations; unless the device
+    /// holds it already (the weights depend on ρ alone).
+    fn write_schedule(&mut self, accelerate: bool) {
+        let key = (accelerate, self.chebyshev.rho().to_bits());
+        if self.schedule == Some(key) {
+            return;
+        }
+        self.schedule = Some(key);
+        let schedule: Vec<(f64, bool)> = (0..self.params.max_outer_iterations)
+            .map(|k| {
+                if accelerate {
+                    let omega = self.chebyshev.next_weight(k);
+                    (omega, self.chebyshev.changes(omega))
+                } else {
+                    (1.0, false)
+                }
+            })
+            .collect();
+        self.stages
+            .control
+            .set_schedule(&self.ctx, &self.buffers, &schedule);
+    }
+
+    /// Records one outer iteration from X^(k) in `b.iterates[current]`: the local and
+    /// global steps, their reduction and the stopping rules' decision (control.rs).
+    fn record_outer_iteration(&self, encoder: &mut wgpu::CommandEncoder, current: usize) {
+        let b = &self.buffers;
+        b.clear_pool(encoder);
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        self.stages.local.record(&mut pass, b, current);
+        self.stages.global.record(&mut pass, b, current);
+        self.reduction.record(&mut pass);
+        self.stages.control.record(&mut pass);
     }
 }
 
@@ -492,6 +524,8 @@ struct Stages {
     local: LocalStep,
     global: GlobalStep,
     finish: Finish,
+    /// The stopping rules of the outer iteration.
+    control: Control,
     /// The physical viscosity's solve, compiled at the first step that needs it.
     viscosity: Option<ViscositySolve>,
 }

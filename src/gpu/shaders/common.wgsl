@@ -38,17 +38,6 @@ struct StepParams {
 
 const WORKGROUP: u32 = 256u;
 
-// The pool of kept corrections of multi-step projections (project.wgsl, sweep.wgsl): the
-// entries taken so far in this local step (also those that did not fit), whether one did not
-// fit, and the entries (m).
-struct Pool {
-    cursor: atomic<u32>,
-    overflow: atomic<u32>,
-    pad0: u32,
-    pad1: u32,
-    entries: array<vec4<f32>>,
-}
-
 // W(r), 1/m³, without branches (docs/method.md §2.1).
 fn kernel_w(r: f32) -> f32 {
     let q = r * P.inv_h;

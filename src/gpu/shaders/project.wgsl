@@ -102,7 +102,7 @@ fn gradients(i: u32, pi: vec3<f32>, mode: u32, lambda: f32, seg: u32) -> Gradien
 fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
            @builtin(local_invocation_index) lid: u32) {
     let i = item(wid, nwg, lid);
-    if i >= P.n {
+    if i >= P.n || kept.stopped != 0u {
         return;
     }
     let xi = x[i].xyz;

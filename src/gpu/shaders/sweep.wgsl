@@ -1,13 +1,15 @@
 // The global step on the diagonal system (docs/method.md §3.1, §3.6) fused with the gather
 // of the local step's corrections and Chebyshev's extrapolation (§3.7), as
 // src/solver/sweep.rs: X^(k+1) replaces X^(k−1) in place, and |X^(k+1) − X^(k)| goes to
-// values.y for the displacement rule (§4). Where the local step found its pool of kept
-// corrections full (project.wgsl), nothing is written but values.w = 1, which tells the
-// host to grow the pool and take the outer iteration again.
+// values.y for the displacement rule (§4). ω and whether to extrapolate are the schedule's
+// for the iteration k (control.wgsl). Nothing is written once the outer iteration has stopped,
+// nor where the local step found its pool of kept corrections full (project.wgsl): the host
+// then grows the pool and takes the outer iteration again.
 
 struct IterParams {
-    // ω of this outer iteration, Chebyshev's γ, whether to extrapolate (0/1), whether the
-    // densities of the last local step are those of the result (0/1, finish.wgsl).
+    // ω (unused here: the schedule's), Chebyshev's γ, whether to extrapolate (unused here),
+    // whether the densities of the last local step are those of the result (0/1,
+    // finish.wgsl).
     omega: f32,
     gamma: f32,
     extrapolate: u32,
@@ -26,6 +28,8 @@ struct IterParams {
 @group(0) @binding(9) var<storage, read_write> kept: Pool;
 @group(0) @binding(10) var<storage, read_write> values: array<vec4<f32>>;
 @group(0) @binding(11) var<storage, read_write> material: array<u32>;
+// ω_k and whether to extrapolate (1/0) of every outer iteration k.
+@group(0) @binding(12) var<storage, read_write> schedule: array<vec4<f32>>;
 
 // Σ_{i: j∈N̄_i} (P_{i,j} − X_j): every correction the local step made to particle j (m),
 // gathered from its own and its neighbours' projections (src/constraint/gather.rs).
@@ -71,8 +75,7 @@ fn sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: ve
     if j >= P.n {
         return;
     }
-    if atomicLoad(&kept.overflow) != 0u {
-        values[j].w = 1.0;
+    if kept.stopped != 0u || atomicLoad(&kept.overflow) != 0u {
         return;
     }
     let x = current[j].xyz;
@@ -88,11 +91,13 @@ fn sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: ve
     let residual = P.mass * (s[j].xyz - x) + gathered(j, x, count) * (P.dt2k * scale);
     var plain = x + residual / diagonal;
     let before = previous[j].xyz;
-    if I.extrapolate != 0u {
+    let step = schedule[kept.k];
+    let omega = step.x;
+    if step.y != 0.0 {
         if I.gamma == 1.0 {
-            plain = plain + (plain - before) * (I.omega - 1.0);
+            plain = plain + (plain - before) * (omega - 1.0);
         } else {
-            plain = before + ((plain - x) * I.gamma + x - before) * I.omega;
+            plain = before + ((plain - x) * I.gamma + x - before) * omega;
         }
     }
     previous[j] = vec4<f32>(plain, 0.0);

@@ -2,8 +2,8 @@
 //! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §1.3),
 //! in single precision. The fluid stays on the device during a step; a step waits on the
 //! device once for the neighbour lists' size, once per four outer iterations, whose stopping
-//! rules (§4) the device applies itself, and once at its end (statistics and the CFL rule,
-//! §8).
+//! rules (§4) the device applies itself, and once at its end for its statistics, the CFL
+//! rule (§8) and the fluid's state together.
 //!
 //! Deterministic on one device and driver: integer atomics only where their result does not
 //! depend on the order (counting particles per cell; each cell's particles are then sorted

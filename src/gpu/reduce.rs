@@ -89,14 +89,4 @@ impl Reduction {
             dispatch_groups(pass, &self.kernel.pipelines[0], &p.group, p.groups);
         }
     }
-
-    /// The reduced value, read back after the commands of `encoder` run.
-    pub fn read(
-        &self,
-        ctx: &Context,
-        encoder: wgpu::CommandEncoder,
-    ) -> Result<[f32; 4], crate::Error> {
-        let v = super::context::floats(&ctx.read(encoder, &self.result, 16)?);
-        Ok([v[0], v[1], v[2], v[3]])
-    }
 }

@@ -240,12 +240,6 @@ impl GpuStepper {
         scope.close(self.ctx.check())
     }
 
-    /// Copies the fluid's state back from the device.
-    pub fn read(&self) -> Result<Readback, Error> {
-        let scope = self.ctx.scope();
-        scope.close(self.read_back())
-    }
-
     /// The device's position buffer after the last step, in the device's order of the
     /// particles ([`Readback::order`]), with their count and the point the positions are
     /// measured from (m, world frame): one `vec4<f32>` per particle, x, y, z in metres from
@@ -254,47 +248,45 @@ impl GpuStepper {
         (&self.buffers.x, self.buffers.n, self.grid.centre)
     }
 
-    fn read_back(&self) -> Result<Readback, Error> {
-        let b = &self.buffers;
-        let n = u64::from(b.n);
-        let sources = [
-            (&b.x, n * 16),
-            (&b.v, n * 16),
-            (&b.density, n * 4),
-            (&b.ids, n * 4),
-        ];
-        let [x, v, densities, order] = &self.ctx.read_many(self.ctx.encoder(), &sources)?[..]
-        else {
-            unreachable!("four buffers were read");
-        };
-        let (x, v, densities, order) = (floats(x), floats(v), floats(densities), words(order));
+    /// The fluid's state as read back in `parts`: positions, velocities, densities and
+    /// each slot's particle, as [`GpuStepper::step`] reads them from the device.
+    fn readback(&self, parts: &[Vec<u8>]) -> Readback {
         let grid = &self.grid;
-        Ok(Readback {
-            positions: x
+        Readback {
+            positions: floats(&parts[0])
                 .chunks_exact(4)
                 .map(|p| grid.world_position([p[0], p[1], p[2], p[3]]))
                 .collect(),
-            velocities: v
+            velocities: floats(&parts[1])
                 .chunks_exact(4)
                 .map(|v| Vec3::new(v[0].into(), v[1].into(), v[2].into()))
                 .collect(),
-            densities: densities.into_iter().map(f64::from).collect(),
-            order,
-        })
+            densities: floats(&parts[2]).into_iter().map(f64::from).collect(),
+            order: words(&parts[3]),
+        }
     }
 
     /// Advances the fluid by one step of `dt` seconds, each material k of the kinematic
     /// viscosity `viscosities[k]` (m²/s; the physical viscosity is solved where one is
-    /// positive); returns what the step did and the size of the next step by the CFL rule
-    /// (s). Errors when the device fails; the fluid's state on the device is then undefined.
-    pub fn step(&mut self, dt: f64, viscosities: &[f64]) -> Result<(StepStats, f64), Error> {
+    /// positive); returns what the step did, the size of the next step by the CFL rule (s)
+    /// and the fluid's state after it, read back with the step's statistics. Errors when
+    /// the device fails; the fluid's state on the device is then undefined.
+    pub fn step(
+        &mut self,
+        dt: f64,
+        viscosities: &[f64],
+    ) -> Result<(StepStats, f64, Readback), Error> {
         let scope = self.ctx.scope();
         let taken = self.advance(dt, viscosities);
         scope.close(taken)
     }
 
     /// [`GpuStepper::step`] within its error scopes.
-    fn advance(&mut self, dt: f64, viscosities: &[f64]) -> Result<(StepStats, f64), Error> {
+    fn advance(
+        &mut self,
+        dt: f64,
+        viscosities: &[f64],
+    ) -> Result<(StepStats, f64, Readback), Error> {
         let viscous = viscosities.iter().any(|&nu| nu > 0.0);
         if viscous && self.stages.viscosity.is_none() {
             let mut solve = ViscositySolve::new(&self.ctx, &self.params);
@@ -358,7 +350,18 @@ impl GpuStepper {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             self.reduction.record(&mut pass);
         }
-        let [error_sum, error_max, fastest, _] = self.reduction.read(&self.ctx, encoder)?;
+        let n = u64::from(b.n);
+        let sources = [
+            (&self.reduction.result, 16),
+            (&b.x, n * 16),
+            (&b.v, n * 16),
+            (&b.density, n * 4),
+            (&b.ids, n * 4),
+        ];
+        let parts = self.ctx.read_many(encoder, &sources)?;
+        let [error_sum, error_max, fastest, _] = <[f32; 4]>::try_from(floats(&parts[0]))
+            .map_err(|_| crate::world::gpu_error("a statistics read-back fell short"))?;
+        let back = self.readback(&parts[1..]);
         timings.rest = finished.elapsed().as_secs_f64();
         let stats = StepStats {
             dt,
@@ -371,7 +374,11 @@ impl GpuStepper {
             density_error_max: f64::from(error_max),
             timings,
         };
-        Ok((stats, next_step_size(&self.params, f64::from(fastest))))
+        Ok((
+            stats,
+            next_step_size(&self.params, f64::from(fastest)),
+            back,
+        ))
     }
 
     /// Records X^(0) = X^(−1) = s.

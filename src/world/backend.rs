@@ -207,8 +207,7 @@ impl World {
         }
         let slot = self.gpu.as_deref_mut().expect("the GPU backend is chosen");
         let stepper = slot.context.as_mut().expect("made above");
-        let (stats, next_dt) = stepper.step(dt, &self.materials.viscosities)?;
-        let back = stepper.read()?;
+        let (stats, next_dt, back) = stepper.step(dt, &self.materials.viscosities)?;
         let fluid = &mut self.fluid;
         // The device's order: every per-particle array the world keeps follows it (the
         // materials of a world of one are all 0 already).

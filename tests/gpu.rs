@@ -362,6 +362,40 @@ fn two_gpu_runs_with_viscosity_agree_to_the_bit() {
     assert!(a.1 != plain.1, "the viscosity changed nothing");
 }
 
+/// Settings changed between steps reach a world already stepping on the GPU, as on the CPU:
+/// 0.1 s into the dam break, with τ so small and η so nearly 0 that no rule holds, a step takes the most outer
+/// iterations twice (Chebyshev's, then the fallback's plain iterations, docs/method.md §4),
+/// on both backends alike; after a change of the most iterations, the next step takes the
+/// new most twice; and after a change back, the rules hold again within the most.
+#[test]
+fn settings_changed_between_steps_reach_the_gpu() {
+    let outer_iterations = |backend: Backend| {
+        let mut world = on_backend(dam_break(), backend);
+        let mut counts = Vec::new();
+        let mut step = |world: &mut World| {
+            world.step().expect("a step");
+            let stats = world.last_step().expect("a step was taken");
+            counts.push((stats.outer_iterations, stats.hit_max_iterations));
+        };
+        world.advance(0.1).expect("the run steps");
+        step(&mut world);
+        world.set_displacement_tolerance(1e-12).expect("τ");
+        world.set_density_tolerance(1e-12).expect("η");
+        world.set_outer_iterations(1, 12).expect("iterations");
+        step(&mut world);
+        world.set_outer_iterations(1, 7).expect("iterations");
+        step(&mut world);
+        world.set_displacement_tolerance(1e-3).expect("τ");
+        step(&mut world);
+        counts
+    };
+    let cpu = outer_iterations(Backend::Cpu);
+    let gpu = outer_iterations(Backend::Gpu);
+    assert_eq!(cpu[1..3], [(24, true), (14, true)], "CPU: {cpu:?}");
+    assert_eq!(gpu[1..3], cpu[1..3], "GPU: {gpu:?}, CPU: {cpu:?}");
+    assert!(!gpu[3].1 && gpu[3].0 <= 7, "GPU: {gpu:?}");
+}
+
 /// Set for the run of [`missing_adapter_probe`] that
 /// [`a_missing_adapter_is_refused_naming_what_is_missing`] starts.
 const PROBE: &str = "PROJFLUID_GPU_TEST_NO_ADAPTER";

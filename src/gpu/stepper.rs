@@ -112,20 +112,30 @@ impl GpuStepper {
         scope.close(Self::assemble(ctx, stages, reduce, chebyshev, n, scene))
     }
 
-    /// The stepper for `scene`, a world with another number of fluid or boundary particles or
-    /// of materials, on this stepper's device: its kernels are not compiled again, and the
-    /// Chebyshev iteration keeps what it has learnt of ρ. `scene` has the parameters this
-    /// stepper was made with. Errors as [`GpuStepper::new`], when the device fails.
+    /// The stepper for `scene`, a world with another number of fluid or boundary particles,
+    /// of materials or other parameters, on this stepper's device: its kernels are compiled
+    /// again only where vorticity confinement was turned on or off, and the Chebyshev
+    /// iteration keeps what it has learnt of ρ unless the solver or its settings changed.
+    /// Errors as [`GpuStepper::new`], when the device fails.
     pub fn remake(self, scene: Scene) -> Result<Self, Error> {
         let n = device_count(&scene)?;
         let scope = self.ctx.scope();
         let GpuStepper {
             ctx,
-            stages,
+            mut stages,
             reduction,
-            chebyshev,
+            mut chebyshev,
+            params,
             ..
         } = self;
+        let new = scene.params;
+        let confine = new.vorticity_confinement > 0.0;
+        if confine != (params.vorticity_confinement > 0.0) {
+            stages.finish = Finish::new(&ctx, confine);
+        }
+        if (new.solver, new.chebyshev) != (params.solver, params.chebyshev) {
+            chebyshev = Chebyshev::new(new.chebyshev);
+        }
         let remade = Self::assemble(ctx, stages, reduction.into_kernel(), chebyshev, n, scene);
         scope.close(remade)
     }
@@ -188,6 +198,11 @@ impl GpuStepper {
     /// The number of fluid particles.
     pub fn len(&self) -> usize {
         self.buffers.n as usize
+    }
+
+    /// The parameters the stepper steps with.
+    pub fn params(&self) -> &Params {
+        &self.params
     }
 
     fn bind(&mut self) {
@@ -289,7 +304,7 @@ impl GpuStepper {
     ) -> Result<(StepStats, f64, Readback), Error> {
         let viscous = viscosities.iter().any(|&nu| nu > 0.0);
         if viscous && self.stages.viscosity.is_none() {
-            let mut solve = ViscositySolve::new(&self.ctx, &self.params);
+            let mut solve = ViscositySolve::new(&self.ctx);
             solve.bind(&self.ctx, &self.buffers, &self.reduction);
             self.stages.viscosity = Some(solve);
         }
@@ -340,7 +355,8 @@ impl GpuStepper {
             .record_update(&mut encoder, b, outcome.result);
         if let Some(solve) = self.stages.viscosity.as_ref().filter(|_| viscous) {
             self.ctx.queue.submit([encoder.finish()]);
-            solve.solve(&self.ctx, b, &self.reduction, viscosities, dt)?;
+            let params = &self.params;
+            solve.solve(&self.ctx, b, &self.reduction, params, viscosities, dt)?;
             encoder = self.ctx.encoder();
         }
         self.stages

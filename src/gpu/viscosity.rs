@@ -80,9 +80,6 @@ const ENTRIES: [&str; 11] = [
 /// The viscosity solve's kernels, with its working buffer and bind group for the buffers
 /// last bound.
 pub(super) struct ViscositySolve {
-    /// The regularisation ε = 0.01 H² (m²) and whether walls hold the fluid (no slip).
-    epsilon: f64,
-    no_slip: bool,
     kernel: Kernel,
     params: wgpu::Buffer,
     work: Option<wgpu::Buffer>,
@@ -90,9 +87,8 @@ pub(super) struct ViscositySolve {
 }
 
 impl ViscositySolve {
-    /// The solve's kernels, compiled, for a world of `params` (its support radius and wall
-    /// condition).
-    pub fn new(ctx: &Context, params: &Params) -> Self {
+    /// The solve's kernels, compiled.
+    pub fn new(ctx: &Context) -> Self {
         let mut slots = vec![Slot::Uniform, Slot::Uniform];
         slots.extend([Slot::Storage; 12]);
         let kernel = ctx.kernel(
@@ -101,10 +97,7 @@ impl ViscositySolve {
             &slots,
             &ENTRIES,
         );
-        let h = params.support_radius();
         ViscositySolve {
-            epsilon: REGULARISATION * h * h,
-            no_slip: params.no_slip,
             kernel,
             params: ctx.uniform("viscosity", &ViscosityParams::zeroed()),
             work: None,
@@ -139,14 +132,16 @@ impl ViscositySolve {
         self.work = Some(work);
     }
 
-    /// Solves for the velocities in `b.v` after the update of a step of `dt` seconds, each
-    /// material k of the kinematic viscosity `viscosities[k]` (m²/s), with the reduction
-    /// `reduction` of `b.values`. Errors when the device fails.
+    /// Solves for the velocities in `b.v` after the update of a step of `dt` seconds in a
+    /// world of `params` (its support radius and wall condition), each material k of the
+    /// kinematic viscosity `viscosities[k]` (m²/s), with the reduction `reduction` of
+    /// `b.values`. Errors when the device fails.
     pub fn solve(
         &self,
         ctx: &Context,
         b: &Buffers,
         reduction: &Reduction,
+        params: &Params,
         viscosities: &[f64],
         dt: f64,
     ) -> Result<(), Error> {
@@ -159,8 +154,8 @@ impl ViscositySolve {
         }
         let params = ViscosityParams {
             coupling: (LAPLACIAN_FACTOR * dt) as f32,
-            epsilon: self.epsilon as f32,
-            no_slip: u32::from(self.no_slip),
+            epsilon: (REGULARISATION * params.support_radius().powi(2)) as f32,
+            no_slip: u32::from(params.no_slip),
             tolerance2: (TOLERANCE * TOLERANCE) as f32,
             exact: (2.0 / LAPLACIAN_FACTOR) as f32,
             most_calibration: MOST_CALIBRATION as f32,

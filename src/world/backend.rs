@@ -148,7 +148,8 @@ impl World {
 
     /// One step of `dt` seconds on the device, after [`World::prepare_steps`]: the emitters
     /// insert their due layers on the host, the fluid is uploaded (the stepper made again
-    /// on the same device where the particles or the materials changed in number), stepped
+    /// on the same device where the particles or the materials changed in number or the
+    /// parameters changed), stepped
     /// and read back, then sinks and the domain remove what left. Errors, the emission
     /// undone, when the device fails or the emission needs more memory than can be had.
     #[cfg(feature = "gpu")]
@@ -177,7 +178,10 @@ impl World {
         let material_count = self.materials.len();
         let stale = slot.boundary_len != boundary_len
             || slot.material_count != material_count
-            || slot.context.as_ref().is_none_or(|s| s.len() != fluid_len);
+            || slot
+                .context
+                .as_ref()
+                .is_none_or(|s| s.len() != fluid_len || s.params() != &self.params);
         if stale {
             let device = slot.device.clone();
             let (points, psi) = self.static_boundary()?;

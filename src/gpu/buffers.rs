@@ -20,6 +20,10 @@ const CELL_SLACK: f64 = 1.0 + 1e-4;
 /// The neighbour lists and the pool of kept corrections are grown to this multiple of what
 /// a step needs.
 const LIST_GROWTH: f64 = 1.25;
+/// Fluid and boundary list entries per particle the lists start with, below what a fluid at
+/// rest needs (about 30 fluid neighbours), so that they grow to what the first step needs.
+const INITIAL_FLUID_ROOM: u64 = 24;
+const INITIAL_BOUNDARY_ROOM: u64 = 4;
 /// Entries the pool of kept corrections starts with: one (a binding of it holds one at
 /// least), as few projections take more than one step (shaders/project.wgsl); the pool
 /// grows to what the local steps ask for.
@@ -226,8 +230,8 @@ impl Buffers {
         let vec4 = |label| ctx.storage(label, particles * VEC4);
         let word = |label, count: u64| ctx.storage(label, count * WORD);
         let cell_words = u64::from(cells) + 1;
-        let fluid_room = particles * 40;
-        let boundary_room = particles * 16;
+        let fluid_room = particles * INITIAL_FLUID_ROOM;
+        let boundary_room = particles * INITIAL_BOUNDARY_ROOM;
         let buffers = Buffers {
             n,
             cells,

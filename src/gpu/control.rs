@@ -34,10 +34,12 @@ const CONTROL_HEADER: u64 = 32;
 struct ControlParams {
     min_iterations: u32,
     max_iterations: u32,
+    n: u32,
+    pad: u32,
     tau: f32,
     motion: f32,
     compression: f32,
-    pad: [f32; 3],
+    pad1: f32,
 }
 
 /// How a batch of outer iterations left the iteration.
@@ -52,6 +54,9 @@ pub(super) enum Stop {
     PoolFull { entries: u64 },
     /// The iteration reached its most iterations.
     Exhausted,
+    /// The neighbour lists the search counted, of `fluid` and `boundary` entries, do not fit
+    /// their room; the outer iteration has not begun.
+    ListsFull { fluid: u64, boundary: u64 },
 }
 
 /// Where the outer iteration stands (`Control` in shaders/control.wgsl).
@@ -79,7 +84,8 @@ pub(super) struct Control {
 impl Control {
     /// The kernel, compiled.
     pub fn new(ctx: &Context) -> Self {
-        let slots = [Slot::Uniform, Slot::Storage, Slot::Storage, Slot::Storage];
+        let mut slots = vec![Slot::Uniform];
+        slots.extend([Slot::Storage; 7]);
         Control {
             kernel: ctx.kernel(
                 "control",
@@ -89,7 +95,7 @@ impl Control {
                     include_str!("shaders/control.wgsl")
                 ),
                 &slots,
-                &["decide"],
+                &["decide", "lists"],
             ),
             params: ctx.uniform("control", &ControlParams::zeroed()),
             group: None,
@@ -100,7 +106,16 @@ impl Control {
     pub fn bind(&mut self, ctx: &Context, b: &Buffers, reduction: &Reduction) {
         self.group = Some(ctx.bind(
             &self.kernel,
-            &[&self.params, &reduction.result, &b.kept, &b.control],
+            &[
+                &self.params,
+                &reduction.result,
+                &b.kept,
+                &b.control,
+                &b.fluid_offset,
+                &b.boundary_offset,
+                &b.fluid_list,
+                &b.boundary_list,
+            ],
         ));
     }
 
@@ -111,10 +126,12 @@ impl Control {
         let rules = ControlParams {
             min_iterations: count(params.min_outer_iterations),
             max_iterations: count(params.max_outer_iterations),
+            n,
+            pad: 0,
             tau: below(tau),
             motion: below(DENSITY_RULE_MOTION * tau),
             compression: at_most(params.density_tolerance, f64::from(n.max(1))),
-            pad: [0.0; 3],
+            pad1: 0.0,
         };
         ctx.queue
             .write_buffer(&self.params, 0, bytemuck::bytes_of(&rules));
@@ -157,11 +174,21 @@ impl Control {
 
     /// Records the rules' decision after an outer iteration's reduction.
     pub fn record(&self, pass: &mut wgpu::ComputePass) {
+        self.record_entry(pass, 0);
+    }
+
+    /// Records the check of the neighbour lists' lengths against their room, before the
+    /// first outer iteration.
+    pub fn record_lists(&self, pass: &mut wgpu::ComputePass) {
+        self.record_entry(pass, 1);
+    }
+
+    fn record_entry(&self, pass: &mut wgpu::ComputePass, entry: usize) {
         let group = self
             .group
             .as_ref()
             .expect("Control::bind runs before a step");
-        dispatch_groups(pass, &self.kernel.pipelines[0], group, 1);
+        dispatch_groups(pass, &self.kernel.pipelines[entry], group, 1);
     }
 
     /// Where the iteration stands after the commands of `encoder` run.
@@ -181,7 +208,11 @@ impl Control {
             2 => Stop::PoolFull {
                 entries: u64::from(control[5]),
             },
-            _ => Stop::Exhausted,
+            3 => Stop::Exhausted,
+            _ => Stop::ListsFull {
+                fluid: u64::from(control[5]),
+                boundary: u64::from(control[6]),
+            },
         };
         Ok(Standing {
             stop,

@@ -2,13 +2,13 @@
 //! s, the counting sort of the fluid by cell (shaders/sort.wgsl, then every array, the
 //! particles' materials too, gathered into the sort's order, shaders/permute.wgsl) and the
 //! fluid and boundary neighbour lists on s (shaders/neighbors.wgsl), counted, laid out by
-//! prefix sums (scan.rs) and filled. The lists' total is read back once per step to size
-//! them.
+//! prefix sums (scan.rs) and filled, without waiting on the device: where the lists turn
+//! out too short, the outer iteration stops before its first step (control.rs) and the
+//! host grows them and fills them again.
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
 use super::scan::{self, Scan};
-use crate::Error;
 
 /// The kernels and bind groups of the neighbour phase.
 pub(super) struct Search {
@@ -121,12 +121,13 @@ impl Search {
             .expect("Search::bind runs before a step")
     }
 
-    /// Predicts, sorts the fluid into its cells, gathers its arrays into that order and
-    /// counts every particle's neighbours; returns the fluid and boundary list lengths
-    /// the step needs.
-    pub fn sort_and_count(&self, ctx: &Context, b: &Buffers) -> Result<(u64, u64), Error> {
+    /// Records the prediction, the sort of the fluid into its cells, the gather of its
+    /// arrays into that order and the count of every particle's neighbours with their
+    /// prefix sums: the lists' lengths, which the stopping rules check against the lists'
+    /// room before the first outer iteration (control.rs), end the fluid and the boundary
+    /// offsets.
+    pub fn record_sort_and_count(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers) {
         let g = self.groups();
-        let mut encoder = ctx.encoder();
         {
             let mut pass = encoder.begin_compute_pass(&Default::default());
             let [clear, predict, scatter, sort_cells] = &self.sort.pipelines[..] else {
@@ -145,22 +146,15 @@ impl Search {
         encoder.copy_buffer_to_buffer(&b.s_out, 0, &b.s, 0, bytes(b.n, 16));
         encoder.copy_buffer_to_buffer(&b.ids_out, 0, &b.ids, 0, bytes(b.n, 4));
         encoder.copy_buffer_to_buffer(&b.material_out, 0, &b.material, 0, bytes(b.n, 4));
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            dispatch(&mut pass, &self.neighbors.pipelines[0], &g.neighbors, b.n);
-            g.fluid.record(&mut pass, &self.scan);
-            g.boundary.record(&mut pass, &self.scan);
-        }
-        // The totals sit after the n offsets of each array; they are read back through
-        // `cell_of`, free once the scatter ran.
-        let last = u64::from(b.n) * 4;
-        encoder.copy_buffer_to_buffer(&b.fluid_offset, last, &b.cell_of, 0, 4);
-        encoder.copy_buffer_to_buffer(&b.boundary_offset, last, &b.cell_of, 4, 4);
-        let totals = super::context::words(&ctx.read(encoder, &b.cell_of, 8)?);
-        Ok((u64::from(totals[0]), u64::from(totals[1])))
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        dispatch(&mut pass, &self.neighbors.pipelines[0], &g.neighbors, b.n);
+        g.fluid.record(&mut pass, &self.scan);
+        g.boundary.record(&mut pass, &self.scan);
     }
 
-    /// Records the lists' fill (after [`Search::sort_and_count`], into room for them).
+    /// Records the lists' fill (after [`Search::record_sort_and_count`]). Where the lists
+    /// have too little room, what it writes is not used: the stopping rules find it before
+    /// the first outer iteration, and the lists are grown and filled again.
     pub fn record_fill(&self, pass: &mut wgpu::ComputePass, b: &Buffers) {
         dispatch(
             pass,

@@ -317,19 +317,11 @@ impl GpuStepper {
             .queue
             .write_buffer(&self.buffers.params, 0, bytemuck::bytes_of(&constants));
 
-        let (fluid, boundary) = self
-            .stages
-            .search
-            .sort_and_count(&self.ctx, &self.buffers)?;
-        if self.buffers.grow_lists(&self.ctx, fluid, boundary) {
-            self.bind();
-        }
         let mut encoder = self.ctx.encoder();
-        {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
-            self.stages.search.record_fill(&mut pass, &self.buffers);
-        }
-        self.start_from_prediction(&mut encoder);
+        self.stages
+            .search
+            .record_sort_and_count(&mut encoder, &self.buffers);
+        self.record_fill_and_start(&mut encoder);
         self.ctx.queue.submit([encoder.finish()]);
         let mut timings = StepTimings {
             neighbors: started.elapsed().as_secs_f64(),
@@ -397,6 +389,15 @@ impl GpuStepper {
         ))
     }
 
+    /// Records the neighbour lists' fill and X^(0) = X^(−1) = s.
+    fn record_fill_and_start(&self, encoder: &mut wgpu::CommandEncoder) {
+        {
+            let mut pass = encoder.begin_compute_pass(&Default::default());
+            self.stages.search.record_fill(&mut pass, &self.buffers);
+        }
+        self.start_from_prediction(encoder);
+    }
+
     /// Records X^(0) = X^(−1) = s.
     fn start_from_prediction(&self, encoder: &mut wgpu::CommandEncoder) {
         let b = &self.buffers;
@@ -432,10 +433,15 @@ impl GpuStepper {
         ctx.queue
             .write_buffer(&b.iter, 0, bytemuck::bytes_of(&iter));
         self.stages.control.start(ctx, b, 0);
-        // The next outer iteration to record, and the last whose pool was found full.
-        let (mut next, mut full_at) = (0, None);
+        // The next outer iteration to record, the last whose pool was found full, and
+        // whether the neighbour lists are yet to be checked against their room.
+        let (mut next, mut full_at, mut check_lists) = (0, None, true);
         let standing = loop {
             let mut encoder = self.ctx.encoder();
+            if check_lists {
+                let mut pass = encoder.begin_compute_pass(&Default::default());
+                self.stages.control.record_lists(&mut pass);
+            }
             let last = (next + BATCH).min(max);
             for k in next..last {
                 self.record_outer_iteration(&mut encoder, k % 2);
@@ -444,6 +450,7 @@ impl GpuStepper {
                 .stages
                 .control
                 .read(&self.ctx, &self.buffers, encoder)?;
+            check_lists = matches!(standing.stop, Stop::ListsFull { .. });
             match standing.stop {
                 Stop::Going if last < max => next = last,
                 Stop::Going => {
@@ -452,6 +459,19 @@ impl GpuStepper {
                     ));
                 }
                 Stop::Converged => break standing,
+                Stop::ListsFull { fluid, boundary } => {
+                    if !self.buffers.grow_lists(&self.ctx, fluid, boundary) {
+                        return Err(crate::world::gpu_error(
+                            "the neighbour lists did not fit the room made for them",
+                        ));
+                    }
+                    self.bind();
+                    let mut encoder = self.ctx.encoder();
+                    self.record_fill_and_start(&mut encoder);
+                    self.ctx.queue.submit([encoder.finish()]);
+                    self.stages.control.start(&self.ctx, &self.buffers, 0);
+                    next = 0;
+                }
                 Stop::PoolFull { entries } => {
                     if full_at == Some(standing.k) {
                         return Err(Error::OutOfMemory(format!(

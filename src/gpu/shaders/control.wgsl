@@ -7,12 +7,15 @@
 //
 // `stopped`: 0 going on, 1 a rule held, 2 the local step found the pool of kept corrections
 // full (the host grows it and takes iteration k again, which left nothing changed), 3 the
-// iteration reached its most iterations.
+// iteration reached its most iterations, 4 the neighbour lists the search counted do not fit
+// their room (`lists`, before the first iteration: the host grows and fills them again).
 
 struct ControlParams {
-    // The fewest and most outer iterations.
+    // The fewest and most outer iterations, and the fluid particles.
     min_iterations: u32,
     max_iterations: u32,
+    n: u32,
+    pad3: u32,
     // The displacement rule's τ, the density rule's motion bound 10τ (m) and its bound on
     // Σ max(ρ_i/ρ0 − 1, 0), each the largest single-precision value the host's
     // double-precision comparison accepts.
@@ -20,8 +23,6 @@ struct ControlParams {
     motion: f32,
     compression: f32,
     pad0: f32,
-    pad1: f32,
-    pad2: f32,
 }
 
 struct Control {
@@ -31,12 +32,13 @@ struct Control {
     current: u32,
     converged: u32,
     densities_known: u32,
-    // The largest move of the last outer iteration (m; f32 max before the first), and the
+    // The largest move of the last outer iteration (m; f32 max before the first); the
     // entries of kept corrections the local step that found the pool full asked for (the
-    // pool's cursor is cleared before the iterations recorded after it).
+    // pool's cursor is cleared before the iterations recorded after it), or the fluid and
+    // boundary list entries the search counted where they did not fit.
     displacement: f32,
     asked: u32,
-    pad0: u32,
+    asked_boundary: u32,
     pad1: u32,
     // δ_k of every outer iteration (m).
     displacements: array<f32>,
@@ -46,6 +48,23 @@ struct Control {
 @group(0) @binding(1) var<storage, read_write> reduced: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read_write> kept: Pool;
 @group(0) @binding(3) var<storage, read_write> control: Control;
+@group(0) @binding(4) var<storage, read_write> fluid_offset: array<u32>;
+@group(0) @binding(5) var<storage, read_write> boundary_offset: array<u32>;
+@group(0) @binding(6) var<storage, read_write> fluid_list: array<u32>;
+@group(0) @binding(7) var<storage, read_write> boundary_list: array<u32>;
+
+// Before the first outer iteration: stops it where the neighbour lists' lengths, at the
+// end of their offsets, exceed their room.
+@compute @workgroup_size(1)
+fn lists() {
+    let fluid = fluid_offset[C.n];
+    let boundary = boundary_offset[C.n];
+    if fluid > arrayLength(&fluid_list) || boundary > arrayLength(&boundary_list) {
+        control.asked = fluid;
+        control.asked_boundary = boundary;
+        kept.stopped = 4u;
+    }
+}
 
 @compute @workgroup_size(1)
 fn decide() {

@@ -10,6 +10,8 @@
 # summaries and the table (default: $OUT, else bench-gpu-out). `quick` runs small scenes
 # only, to try the script on a software Vulkan device (Mesa's lavapipe).
 #
+# On the GPU the search is not waited for, so its time counts in the outer iteration's.
+#
 # The cases: dam_break_30k for 1 s (real time on the GPU is the goal), obstacle_298k and
 # dam_break_1m for a fixed number of steps on both backends (the GPU ≥ 10 times the cores),
 # and bench/gpu/dam_break_10m.json for a few steps on the GPU (it fits and runs). Each run has

@@ -1,9 +1,9 @@
 //! The GPU backend (feature `gpu`): the time step of a world's fluid and static boundary
 //! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §1.3),
 //! in single precision. The fluid stays on the device during a step; a step waits on the
-//! device once for the neighbour lists' size, once per four outer iterations, whose stopping
-//! rules (§4) the device applies itself, and once at its end for its statistics, the CFL
-//! rule (§8) and the fluid's state together.
+//! device once per four outer iterations, whose stopping rules (§4) the device applies
+//! itself (and where the neighbour lists or the pool of kept corrections must grow), and
+//! once at its end for its statistics, the CFL rule (§8) and the fluid's state together.
 //!
 //! Deterministic on one device and driver: integer atomics only where their result does not
 //! depend on the order (counting particles per cell; each cell's particles are then sorted

@@ -3,11 +3,12 @@
 //! displacement rules and the most iterations, as src/step/iterate.rs does, so that the host
 //! submits [`BATCH`] iterations at a time with Chebyshev's weights laid out in advance (the
 //! schedule) and reads back only where they stopped. The iterations recorded after a stop
-//! change nothing.
+//! change nothing. Before the first iteration the same thread checks the neighbour lists'
+//! lengths against their room.
 //!
 //! The rules compare single-precision reductions with the double-precision tolerances; each
-//! tolerance goes to the device as the largest single-precision bound that the host's
-//! double-precision comparison accepts, so the device decides as the host would.
+//! tolerance goes to the device as the single-precision bound with which the device's
+//! comparison accepts exactly the values the host's double-precision comparison accepts.
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch_groups, floats, words};
@@ -74,7 +75,8 @@ pub(super) struct Standing {
     pub displacement: f64,
 }
 
-/// The rules' kernel, its constants and its bind group.
+/// The rules' kernels (the decision after an iteration, the lists' check), their constants
+/// and their bind group.
 pub(super) struct Control {
     kernel: Kernel,
     params: wgpu::Buffer,

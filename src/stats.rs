@@ -1,15 +1,18 @@
 //! Per-step statistics: what one time step did and where its time went.
 
-/// Wall-clock seconds spent in the parts of one step.
+/// Wall-clock seconds spent in the parts of one step. On the GPU backend they are the
+/// device's own times, from timestamps it writes around its work where it has them (else the
+/// host's clock between waits), and the local projections count with the global step.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct StepTimings {
     /// Prediction, sorting and neighbour search (s).
     pub neighbors: f64,
-    /// Local projections (s).
+    /// Local projections (s; 0 on the GPU backend).
     pub local: f64,
-    /// Right-hand side, global solves and extrapolation (s).
+    /// Right-hand side, global solves and extrapolation (s; with the local projections on
+    /// the GPU backend).
     pub global: f64,
-    /// Velocity update, densities, XSPH and statistics (s).
+    /// Velocity update, densities, the non-pressure forces, XSPH and statistics (s).
     pub rest: f64,
 }
 

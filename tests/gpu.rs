@@ -362,6 +362,28 @@ fn two_gpu_runs_with_viscosity_agree_to_the_bit() {
     assert!(a.1 != plain.1, "the viscosity changed nothing");
 }
 
+/// A GPU step reports the device's own time in each stage, from timestamps (lavapipe and
+/// graphics cards have them): the search, which the host does not wait for, takes a real
+/// share of the step, every stage some time, and together no more than the step took.
+#[test]
+fn a_gpu_step_reports_the_devices_time_per_stage() {
+    let mut world = on_gpu(dam_break());
+    world.advance(0.05).expect("the run steps");
+    for _ in 0..5 {
+        let started = std::time::Instant::now();
+        world.step().expect("a step on the GPU");
+        let wall = started.elapsed().as_secs_f64();
+        let t = world.last_step().expect("a step was taken").timings;
+        let report = format!("{t:?} in a step of {wall} s");
+        assert!(t.neighbors > 0.02 * wall, "{report}");
+        assert!(t.global > 0.0 && t.rest > 0.0, "{report}");
+        assert!(
+            t.neighbors + t.local + t.global + t.rest <= wall,
+            "{report}"
+        );
+    }
+}
+
 /// Settings changed between steps reach a world already stepping on the GPU, as on the CPU:
 /// 0.1 s into the dam break, with τ so small and η so nearly 0 that no rule holds, a step takes the most outer
 /// iterations twice (Chebyshev's, then the fallback's plain iterations, docs/method.md §4),

@@ -10,7 +10,7 @@
 # summaries and the table (default: $OUT, else bench-gpu-out). `quick` runs small scenes
 # only, to try the script on a software Vulkan device (Mesa's lavapipe).
 #
-# On the GPU the search is not waited for, so its time counts in the outer iteration's.
+# On the GPU the stages' times are the device's own, from timestamps around its passes.
 #
 # The cases: dam_break_30k for 1 s (real time on the GPU is the goal), obstacle_298k and
 # dam_break_1m for a fixed number of steps on both backends (the GPU ≥ 10 times the cores),

@@ -121,7 +121,8 @@ impl Context {
         };
         let (device, queue) = block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("projfluid"),
-            required_features: wgpu::Features::empty(),
+            // Timestamps time the step's stages (timer.rs) where the adapter has them.
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits,
             experimental_features: wgpu::ExperimentalFeatures::disabled(),
             memory_hints: wgpu::MemoryHints::Performance,

@@ -7,6 +7,7 @@
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
+use super::timer::{Stage, Timer};
 use crate::params::Params;
 
 /// The finishing kernels with a bind group for each iterate buffer holding the result, and
@@ -97,8 +98,14 @@ impl Finish {
 
     /// Records the update from the result in `b.iterates[result]`: the velocities from the
     /// positions, the new positions and the densities at them.
-    pub fn record_update(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
+    pub fn record_update(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut Timer,
+        b: &Buffers,
+        result: usize,
+    ) {
+        let mut pass = timer.pass(encoder, Stage::End);
         dispatch(
             &mut pass,
             &self.kernel.pipelines[0],
@@ -110,9 +117,15 @@ impl Finish {
     /// Records what follows the update and the physical viscosity: the vorticity
     /// confinement where it is on and the XSPH filter, whose velocities are copied back
     /// into `b.v`.
-    pub fn record_filters(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers, result: usize) {
+    pub fn record_filters(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut Timer,
+        b: &Buffers,
+        result: usize,
+    ) {
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = timer.pass(encoder, Stage::End);
             if let Some(v) = &self.vorticity {
                 let confine = v.group.as_ref().expect("Finish::bind runs before a step");
                 dispatch(&mut pass, &v.kernel.pipelines[0], confine, b.n);

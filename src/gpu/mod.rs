@@ -23,7 +23,8 @@
 //! [`local`] (the projections), [`global`] (gather, Jacobi sweep, Chebyshev), [`reduce`]
 //! (the reductions of the stopping rules and statistics), [`control`] (the stopping rules),
 //! [`finish`] (velocities, densities, vorticity confinement, XSPH, CFL), [`viscosity`] (the
-//! physical viscosity's solve) and [`stepper`] (the step in order). Shaders are in
+//! physical viscosity's solve), [`timer`] (the device's time per stage) and [`stepper`]
+//! (the step in order). Shaders are in
 //! `shaders/`.
 
 /// A shader's WGSL source with shaders/common.wgsl (the step's constants, the kernel, the
@@ -50,6 +51,7 @@ mod reduce;
 mod scan;
 mod search;
 mod stepper;
+mod timer;
 mod viscosity;
 
 pub(crate) use context::check_limits;

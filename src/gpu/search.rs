@@ -9,6 +9,7 @@
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
 use super::scan::{self, Scan};
+use super::timer::{Stage, Timer};
 
 /// The kernels and bind groups of the neighbour phase.
 pub(super) struct Search {
@@ -126,10 +127,15 @@ impl Search {
     /// prefix sums: the lists' lengths, which the stopping rules check against the lists'
     /// room before the first outer iteration (control.rs), end the fluid and the boundary
     /// offsets.
-    pub fn record_sort_and_count(&self, encoder: &mut wgpu::CommandEncoder, b: &Buffers) {
+    pub fn record_sort_and_count(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut Timer,
+        b: &Buffers,
+    ) {
         let g = self.groups();
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = timer.pass(encoder, Stage::Search);
             let [clear, predict, scatter, sort_cells] = &self.sort.pipelines[..] else {
                 unreachable!("the sort module has four entry points");
             };
@@ -146,7 +152,7 @@ impl Search {
         encoder.copy_buffer_to_buffer(&b.s_out, 0, &b.s, 0, bytes(b.n, 16));
         encoder.copy_buffer_to_buffer(&b.ids_out, 0, &b.ids, 0, bytes(b.n, 4));
         encoder.copy_buffer_to_buffer(&b.material_out, 0, &b.material, 0, bytes(b.n, 4));
-        let mut pass = encoder.begin_compute_pass(&Default::default());
+        let mut pass = timer.pass(encoder, Stage::Search);
         dispatch(&mut pass, &self.neighbors.pipelines[0], &g.neighbors, b.n);
         g.fluid.record(&mut pass, &self.scan);
         g.boundary.record(&mut pass, &self.scan);

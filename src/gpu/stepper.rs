@@ -21,7 +21,8 @@ use super::global::GlobalStep;
 use super::local::LocalStep;
 use super::reduce::Reduction;
 use super::search::Search;
-use super::viscosity::ViscositySolve;
+use super::timer::{Stage, Timer};
+use super::viscosity::{ViscositySolve, ViscousStep};
 use crate::boundary::Aabb;
 use crate::material::MaterialId;
 use crate::params::{Params, ProjectionWeight, SolverKind};
@@ -106,6 +107,7 @@ impl GpuStepper {
             finish: Finish::new(&ctx, confine),
             control: Control::new(&ctx),
             viscosity: None,
+            timer: Timer::new(&ctx),
         };
         let reduce = Reduction::compile(&ctx);
         let chebyshev = Chebyshev::new(scene.params.chebyshev);
@@ -292,13 +294,17 @@ impl GpuStepper {
         viscosities: &[f64],
     ) -> Result<(StepStats, f64, Readback), Error> {
         let scope = self.ctx.scope();
-        let taken = self.advance(dt, viscosities);
+        let mut timer = std::mem::take(&mut self.stages.timer);
+        timer.start();
+        let taken = self.advance(&mut timer, dt, viscosities);
+        self.stages.timer = timer;
         scope.close(taken)
     }
 
-    /// [`GpuStepper::step`] within its error scopes.
+    /// [`GpuStepper::step`] within its error scopes, its passes timed by `timer`.
     fn advance(
         &mut self,
+        timer: &mut Timer,
         dt: f64,
         viscosities: &[f64],
     ) -> Result<(StepStats, f64, Readback), Error> {
@@ -320,8 +326,8 @@ impl GpuStepper {
         let mut encoder = self.ctx.encoder();
         self.stages
             .search
-            .record_sort_and_count(&mut encoder, &self.buffers);
-        self.record_fill_and_start(&mut encoder);
+            .record_sort_and_count(&mut encoder, timer, &self.buffers);
+        self.record_fill_and_start(&mut encoder, timer);
         self.ctx.queue.submit([encoder.finish()]);
         let mut timings = StepTimings {
             neighbors: started.elapsed().as_secs_f64(),
@@ -329,7 +335,7 @@ impl GpuStepper {
         };
 
         let iterated = Instant::now();
-        let outcome = self.iterate()?;
+        let outcome = self.iterate(timer)?;
         timings.global = iterated.elapsed().as_secs_f64();
 
         let finished = Instant::now();
@@ -344,33 +350,44 @@ impl GpuStepper {
         let mut encoder = self.ctx.encoder();
         self.stages
             .finish
-            .record_update(&mut encoder, b, outcome.result);
+            .record_update(&mut encoder, timer, b, outcome.result);
         if let Some(solve) = self.stages.viscosity.as_ref().filter(|_| viscous) {
             self.ctx.queue.submit([encoder.finish()]);
-            let params = &self.params;
-            solve.solve(&self.ctx, b, &self.reduction, params, viscosities, dt)?;
+            let step = ViscousStep {
+                params: &self.params,
+                viscosities,
+                dt,
+            };
+            solve.solve(&self.ctx, timer, b, &self.reduction, &step)?;
             encoder = self.ctx.encoder();
         }
         self.stages
             .finish
-            .record_filters(&mut encoder, b, outcome.result);
+            .record_filters(&mut encoder, timer, b, outcome.result);
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = timer.pass(&mut encoder, Stage::End);
             self.reduction.record(&mut pass);
         }
         let n = u64::from(b.n);
-        let sources = [
+        let mut sources = vec![
             (&self.reduction.result, 16),
             (&b.x, n * 16),
             (&b.v, n * 16),
             (&b.density, n * 4),
             (&b.ids, n * 4),
         ];
+        let timed = timer.resolve(&mut encoder);
+        sources.extend(timed);
         let parts = self.ctx.read_many(encoder, &sources)?;
         let [error_sum, error_max, fastest, _] = <[f32; 4]>::try_from(floats(&parts[0]))
             .map_err(|_| crate::world::gpu_error("a statistics read-back fell short"))?;
-        let back = self.readback(&parts[1..]);
+        let back = self.readback(&parts[1..5]);
         timings.rest = finished.elapsed().as_secs_f64();
+        if let Some(stamps) = parts.get(5) {
+            // The device's own times, where it has timestamps.
+            let [search, iteration, end] = timer.seconds(stamps);
+            (timings.neighbors, timings.global, timings.rest) = (search, iteration, end);
+        }
         let stats = StepStats {
             dt,
             outer_iterations: outcome.outer,
@@ -390,9 +407,9 @@ impl GpuStepper {
     }
 
     /// Records the neighbour lists' fill and X^(0) = X^(−1) = s.
-    fn record_fill_and_start(&self, encoder: &mut wgpu::CommandEncoder) {
+    fn record_fill_and_start(&self, encoder: &mut wgpu::CommandEncoder, timer: &mut Timer) {
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = timer.pass(encoder, Stage::Search);
             self.stages.search.record_fill(&mut pass, &self.buffers);
         }
         self.start_from_prediction(encoder);
@@ -414,7 +431,7 @@ impl GpuStepper {
     /// once, the device applying the rules after each (control.rs); the host reads back
     /// where they stopped, grows the pool of kept corrections where a local step found it
     /// full and takes that iteration again, and restarts for the fallback.
-    fn iterate(&mut self) -> Result<Outcome, Error> {
+    fn iterate(&mut self, timer: &mut Timer) -> Result<Outcome, Error> {
         let params = self.params.clone();
         let max = params.max_outer_iterations;
         self.chebyshev.reset();
@@ -439,12 +456,12 @@ impl GpuStepper {
         let standing = loop {
             let mut encoder = self.ctx.encoder();
             if check_lists {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
+                let mut pass = timer.pass(&mut encoder, Stage::Iteration);
                 self.stages.control.record_lists(&mut pass);
             }
             let last = (next + BATCH).min(max);
             for k in next..last {
-                self.record_outer_iteration(&mut encoder, k % 2);
+                self.record_outer_iteration(&mut encoder, timer, k % 2);
             }
             let standing = self
                 .stages
@@ -467,7 +484,7 @@ impl GpuStepper {
                     }
                     self.bind();
                     let mut encoder = self.ctx.encoder();
-                    self.record_fill_and_start(&mut encoder);
+                    self.record_fill_and_start(&mut encoder, timer);
                     self.ctx.queue.submit([encoder.finish()]);
                     self.stages.control.start(&self.ctx, &self.buffers, 0);
                     next = 0;
@@ -550,10 +567,15 @@ impl GpuStepper {
 
     /// Records one outer iteration from X^(k) in `b.iterates[current]`: the local and
     /// global steps, their reduction and the stopping rules' decision (control.rs).
-    fn record_outer_iteration(&self, encoder: &mut wgpu::CommandEncoder, current: usize) {
+    fn record_outer_iteration(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        timer: &mut Timer,
+        current: usize,
+    ) {
         let b = &self.buffers;
         b.clear_pool(encoder);
-        let mut pass = encoder.begin_compute_pass(&Default::default());
+        let mut pass = timer.pass(encoder, Stage::Iteration);
         self.stages.local.record(&mut pass, b, current);
         self.stages.global.record(&mut pass, b, current);
         self.reduction.record(&mut pass);
@@ -561,7 +583,8 @@ impl GpuStepper {
     }
 }
 
-/// The compiled stages of a step, kept when a stepper is remade.
+/// The compiled stages of a step and the timer of their passes, kept when a stepper is
+/// remade.
 struct Stages {
     search: Search,
     local: LocalStep,
@@ -571,6 +594,7 @@ struct Stages {
     control: Control,
     /// The physical viscosity's solve, compiled at the first step that needs it.
     viscosity: Option<ViscositySolve>,
+    timer: Timer,
 }
 
 /// The number of fluid particles of `scene` on the device. Errors when the fluid or the

@@ -10,6 +10,7 @@
 use super::buffers::{Buffers, MATERIAL_SLOTS};
 use super::context::{Context, Kernel, Slot, dispatch, dispatch_groups, floats};
 use super::reduce::Reduction;
+use super::timer::{Stage, Timer};
 use crate::Error;
 use crate::forces::viscosity::{
     LAPLACIAN_FACTOR, MAX_ITERATIONS, MOST_CALIBRATION, REGULARISATION, TOLERANCE,
@@ -77,6 +78,17 @@ const ENTRIES: [&str; 11] = [
     "direction",
 ];
 
+/// The step a solve belongs to.
+#[derive(Clone, Copy)]
+pub(super) struct ViscousStep<'a> {
+    /// The world's parameters: its support radius and wall condition.
+    pub params: &'a Params,
+    /// Each material's kinematic viscosity ν (m²/s), by id.
+    pub viscosities: &'a [f64],
+    /// The step size Δt (s).
+    pub dt: f64,
+}
+
 /// The viscosity solve's kernels, with its working buffer and bind group for the buffers
 /// last bound.
 pub(super) struct ViscositySolve {
@@ -132,19 +144,21 @@ impl ViscositySolve {
         self.work = Some(work);
     }
 
-    /// Solves for the velocities in `b.v` after the update of a step of `dt` seconds in a
-    /// world of `params` (its support radius and wall condition), each material k of the
-    /// kinematic viscosity `viscosities[k]` (m²/s), with the reduction `reduction` of
-    /// `b.values`. Errors when the device fails.
+    /// Solves for the velocities in `b.v` after the update of `step`, with the reduction
+    /// `reduction` of `b.values`, its passes timed by `timer`. Errors when the device fails.
     pub fn solve(
         &self,
         ctx: &Context,
+        timer: &mut Timer,
         b: &Buffers,
         reduction: &Reduction,
-        params: &Params,
-        viscosities: &[f64],
-        dt: f64,
+        step: &ViscousStep,
     ) -> Result<(), Error> {
+        let ViscousStep {
+            params,
+            viscosities,
+            dt,
+        } = *step;
         let (Some(group), Some(work)) = (&self.group, &self.work) else {
             return Err(crate::world::gpu_error("the viscosity solve is not bound"));
         };
@@ -175,7 +189,7 @@ impl ViscositySolve {
         };
         let mut encoder = ctx.encoder();
         {
-            let mut pass = encoder.begin_compute_pass(&Default::default());
+            let mut pass = timer.pass(&mut encoder, Stage::End);
             each(&mut pass, Entry::Volumes);
             each(&mut pass, Entry::Calibrate);
             each(&mut pass, Entry::Begin);
@@ -189,7 +203,7 @@ impl ViscositySolve {
         for _ in 0..MAX_ITERATIONS.div_ceil(BATCH) {
             let mut encoder = ctx.encoder();
             {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
+                let mut pass = timer.pass(&mut encoder, Stage::End);
                 for _ in 0..BATCH {
                     each(&mut pass, Entry::Product);
                     reduction.record(&mut pass);

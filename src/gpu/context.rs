@@ -25,6 +25,8 @@ pub(super) struct Context {
     /// Where the handler of a device projfluid opened keeps the errors no scope caught; a
     /// caller's device keeps its own handler, and this stays empty.
     errors: Arc<Mutex<Option<String>>>,
+    /// The staging buffer of the last read-back, kept for the next one that fits in it.
+    staging: Mutex<Option<wgpu::Buffer>>,
 }
 
 /// Error scopes over one operation on the device ([`Context::scope`]): every error the
@@ -141,6 +143,7 @@ impl Context {
             queue,
             adapter: name,
             errors,
+            staging: Mutex::new(None),
         })
     }
 
@@ -155,6 +158,7 @@ impl Context {
             queue,
             adapter: "(the caller's device)".to_string(),
             errors: Arc::new(Mutex::new(None)),
+            staging: Mutex::new(None),
         })
     }
 
@@ -316,7 +320,8 @@ impl Context {
 
     /// The first bytes of each of `sources` (buffer and byte count, a multiple of 4), copied
     /// back through one staging buffer after the commands of `encoder` run: one wait on the
-    /// device for them all.
+    /// device for them all. The staging buffer is kept for the next read-back that fits in
+    /// it (it grows to the largest so far).
     pub fn read_many(
         &self,
         mut encoder: wgpu::CommandEncoder,
@@ -326,12 +331,17 @@ impl Context {
             .iter()
             .map(|&(_, bytes)| bytes.max(4).next_multiple_of(4))
             .collect();
-        let staging = self.device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("read-back"),
-            size: sizes.iter().sum(),
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        let total: u64 = sizes.iter().sum();
+        let kept = self.staging.lock().ok().and_then(|mut slot| slot.take());
+        let staging = match kept {
+            Some(buffer) if buffer.size() >= total => buffer,
+            _ => self.device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some("read-back"),
+                size: total,
+                usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            }),
+        };
         let mut offset = 0;
         for (&(source, _), &size) in sources.iter().zip(&sizes) {
             encoder.copy_buffer_to_buffer(source, 0, &staging, offset, size);
@@ -340,7 +350,7 @@ impl Context {
         self.queue.submit([encoder.finish()]);
         let mapped = Arc::new(Mutex::new(None));
         let done = Arc::clone(&mapped);
-        staging.map_async(wgpu::MapMode::Read, .., move |result| {
+        staging.map_async(wgpu::MapMode::Read, ..total, move |result| {
             if let Ok(mut slot) = done.lock() {
                 *slot = Some(result);
             }
@@ -358,10 +368,13 @@ impl Context {
             }
         }
         let bytes = staging
-            .get_mapped_range(..)
+            .get_mapped_range(..total)
             .map_err(|e| gpu_error(&format!("could not map a read-back: {e}")))?
             .to_vec();
         staging.unmap();
+        if let Ok(mut slot) = self.staging.lock() {
+            *slot = Some(staging);
+        }
         let mut start = 0;
         Ok(sizes
             .iter()

@@ -1,5 +1,5 @@
 //! The GPU backend (feature `gpu`): the time step of a world's fluid and static boundary
-//! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §1.3),
+//! particles on a graphics card, through wgpu compute shaders in WGSL (docs/method.md §16),
 //! in single precision. The fluid stays on the device during a step; a step waits on the
 //! device once per four outer iterations, whose stopping rules (§4) the device applies
 //! itself (and where the neighbour lists or the pool of kept corrections must grow), and

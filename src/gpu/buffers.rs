@@ -69,17 +69,17 @@ pub(super) struct StepParams {
     pub inverse_ratio: [[f32; 4]; MATERIAL_SLOTS / 4],
 }
 
-/// One outer iteration's constants (`IterParams` in shaders/sweep.wgsl, finish.wgsl).
+/// The outer iteration's constants besides its schedule (`IterParams` in
+/// shaders/sweep.wgsl, finish.wgsl; ω_k and whether to extrapolate are in
+/// [`Buffers::schedule`]).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, Pod, Zeroable)]
 pub(super) struct IterParams {
-    /// Chebyshev's ω and γ.
-    pub omega: f32,
+    /// Chebyshev's γ.
     pub gamma: f32,
-    /// 1 to extrapolate this iteration.
-    pub extrapolate: u32,
     /// 1 when the last local step's densities are the result's.
     pub densities_known: u32,
+    pub pad: [u32; 2],
 }
 
 /// A uniform grid of cells at least H wide over a fixed box; particles outside it are

@@ -367,23 +367,25 @@ impl Context {
                 )));
             }
         }
-        let bytes = staging
-            .get_mapped_range(..total)
-            .map_err(|e| gpu_error(&format!("could not map a read-back: {e}")))?
-            .to_vec();
+        let parts = {
+            let bytes = staging
+                .get_mapped_range(..total)
+                .map_err(|e| gpu_error(&format!("could not map a read-back: {e}")))?;
+            let mut start = 0;
+            sizes
+                .iter()
+                .map(|&size| {
+                    let part = bytes[start as usize..(start + size) as usize].to_vec();
+                    start += size;
+                    part
+                })
+                .collect()
+        };
         staging.unmap();
         if let Ok(mut slot) = self.staging.lock() {
             *slot = Some(staging);
         }
-        let mut start = 0;
-        Ok(sizes
-            .iter()
-            .map(|&size| {
-                let part = bytes[start as usize..(start + size) as usize].to_vec();
-                start += size;
-                part
-            })
-            .collect())
+        Ok(parts)
     }
 }
 

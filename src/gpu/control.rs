@@ -15,14 +15,11 @@ use super::context::{Context, Kernel, Slot, dispatch_groups, floats, words};
 use super::reduce::Reduction;
 use crate::Error;
 use crate::params::Params;
+use crate::step::iterate::DENSITY_RULE_MOTION;
 use bytemuck::{Pod, Zeroable};
 
 /// Outer iterations submitted between two reads of where the iteration stands.
 pub(super) const BATCH: usize = 4;
-
-/// The density rule also waits until the last outer iteration moved no particle farther
-/// than this multiple of τ (as src/step/iterate.rs).
-const DENSITY_RULE_MOTION: f64 = 10.0;
 
 /// Bytes of the pool's header before `stopped` (its cursor and overflow flag), and of the
 /// control block before the displacements (shaders/control.wgsl).

@@ -340,6 +340,7 @@ impl GpuStepper {
 
         let finished = Instant::now();
         let iter = IterParams {
+            gamma: self.params.chebyshev.gamma as f32,
             densities_known: u32::from(outcome.densities_known),
             ..IterParams::default()
         };
@@ -510,10 +511,7 @@ impl GpuStepper {
                         break standing;
                     }
                     // docs/method.md §4, "Fallback".
-                    let control = &self.stages.control;
-                    let displacements =
-                        control.displacements(&self.ctx, &self.buffers, standing.k)?;
-                    self.chebyshev.finish_step(&displacements);
+                    self.learn_rho(standing.k)?;
                     accelerate = false;
                     self.write_schedule(accelerate);
                     let mut encoder = self.ctx.encoder();
@@ -527,9 +525,7 @@ impl GpuStepper {
             }
         };
         if accelerate {
-            let control = &self.stages.control;
-            let displacements = control.displacements(&self.ctx, &self.buffers, standing.k)?;
-            self.chebyshev.finish_step(&displacements);
+            self.learn_rho(standing.k)?;
         }
         Ok(Outcome {
             outer: standing.outer,
@@ -539,6 +535,18 @@ impl GpuStepper {
             densities_known: standing.densities_known,
             result: standing.current,
         })
+    }
+
+    /// Lets Chebyshev's online estimate learn from the `k` extrapolated iterations just
+    /// taken (docs/method.md §5.3), their displacements read back from the device; nothing
+    /// is read where ρ is fixed.
+    fn learn_rho(&mut self, k: usize) -> Result<(), Error> {
+        if self.params.chebyshev.auto_rho {
+            let control = &self.stages.control;
+            let displacements = control.displacements(&self.ctx, &self.buffers, k)?;
+            self.chebyshev.finish_step(&displacements);
+        }
+        Ok(())
     }
 
     /// Writes the schedule of the outer iteration: Chebyshev's ω_k and whether to

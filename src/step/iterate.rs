@@ -23,7 +23,7 @@ use std::time::Instant;
 /// than this multiple of τ: a few particles still moving fast (a splash particle being pushed
 /// back out of a wall) keep the iteration going, though they hardly change the average
 /// (docs/method.md §4).
-const DENSITY_RULE_MOTION: f64 = 10.0;
+pub(crate) const DENSITY_RULE_MOTION: f64 = 10.0;
 
 /// What the iteration reads besides the buffers.
 pub(super) struct Iteration<'a> {

@@ -12,7 +12,7 @@
 mod coarse;
 mod couple;
 mod finish;
-mod iterate;
+pub(crate) mod iterate;
 mod search;
 mod undo;
 mod warm_start;

@@ -6,10 +6,10 @@
 // `xsph`.
 
 struct IterParams {
-    omega: f32,
     gamma: f32,
-    extrapolate: u32,
     densities_known: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: StepParams;

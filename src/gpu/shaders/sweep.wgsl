@@ -7,13 +7,12 @@
 // then grows the pool and takes the outer iteration again.
 
 struct IterParams {
-    // ω (unused here: the schedule's), Chebyshev's γ, whether to extrapolate (unused here),
-    // whether the densities of the last local step are those of the result (0/1,
-    // finish.wgsl).
-    omega: f32,
+    // Chebyshev's γ, and whether the densities of the last local step are those of the
+    // result (0/1, finish.wgsl).
     gamma: f32,
-    extrapolate: u32,
     densities_known: u32,
+    pad0: u32,
+    pad1: u32,
 }
 
 @group(0) @binding(0) var<uniform> P: StepParams;

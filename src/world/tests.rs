@@ -227,6 +227,45 @@ mod step {
         );
     }
 
+    /// The constraints are a penalty, so a column holds up its weight only by staying
+    /// compressed, in proportion to m|g|/k (docs/method.md §3.2). At the default k a resting
+    /// column 64 particles (3.2 m) tall settles where that compression exceeds η: from 0.2 s
+    /// on every step runs to the iteration limit (and its fallback's) and ends above η
+    /// (0.077 %, measured). At k = 10⁶ N/m the same steps end by the stopping rules, within η,
+    /// in a fraction of the iterations (about 29 a step over 2 s, measured).
+    #[test]
+    fn a_stiffer_k_holds_deep_water_within_eta() {
+        let run = |stiffness: f64| {
+            let params = Params {
+                stiffness,
+                ..Params::default()
+            };
+            let top = Vec3::new(0.45625, 3.5, 0.45625);
+            let mut world = block_in_box(params, top, [8, 64, 8]);
+            let (mut outer, mut steps, mut limited, mut above) = (0, 0, 0, 0);
+            let eta = world.params().density_tolerance;
+            while world.time() < 0.3 {
+                let s = world.step().unwrap().clone();
+                if world.time() > 0.2 {
+                    outer += s.outer_iterations;
+                    steps += 1;
+                    limited += usize::from(s.hit_max_iterations);
+                    above += usize::from(s.density_error_avg > eta);
+                }
+            }
+            (outer as f64 / steps as f64, steps, limited, above)
+        };
+        let (soft, stiff) = (run(5e4), run(1e6));
+        assert!(
+            soft.2 == soft.1 && soft.3 == soft.1,
+            "k = 5e4: {soft:?} (outer iterations per step, steps, at the limit, above eta)"
+        );
+        assert!(
+            stiff.2 == 0 && stiff.3 == 0 && stiff.0 < 0.25 * soft.0,
+            "k = 1e6: {stiff:?} against {soft:?} at k = 5e4"
+        );
+    }
+
     /// Steps the small dam break twice for 25 steps, once as is and once changed by
     /// `variant`, and asserts the two trajectories are bitwise the same.
     fn steps_bitwise_alike(variant: impl FnOnce(&mut World)) {

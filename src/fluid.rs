@@ -18,6 +18,10 @@ pub(crate) struct Fluid {
     /// active constraint moved it; the next step starts from a share of it
     /// (docs/method.md §4.1). Empty while the warm start is off, else one per particle.
     pub supports: Vec<Vec3>,
+    /// Each particle's pressure from the constraint forces of the last step (Pa), one per
+    /// particle; empty where the last step did not carry them (docs/method.md §10.1) or
+    /// particles were added or moved since.
+    pub pressures: Vec<f64>,
     /// Each particle's material (docs/method.md §14).
     pub materials: Vec<MaterialId>,
     /// Each stored particle's id: given in the order particles were added, never reused.
@@ -65,6 +69,7 @@ impl Fluid {
         if !self.supports.is_empty() {
             self.supports.resize(self.positions.len(), Vec3::zeros());
         }
+        self.pressures.clear();
         self.ids.extend(first..first + count);
         self.ascending.extend(first..first + count);
         self.next_id = first + count;
@@ -78,6 +83,7 @@ impl Fluid {
         self.densities.truncate(len);
         self.materials.truncate(len);
         self.supports.truncate(len);
+        self.pressures.clear();
         self.ids.truncate(len);
         self.ascending.truncate(len);
         self.next_id = next_id;
@@ -121,6 +127,9 @@ impl Fluid {
             if let Some(&a) = self.supports.get(i) {
                 self.supports[kept] = a;
             }
+            if let Some(&p) = self.pressures.get(i) {
+                self.pressures[kept] = p;
+            }
             self.ids[kept] = id;
             kept += 1;
         }
@@ -132,6 +141,7 @@ impl Fluid {
         self.densities.truncate(kept);
         self.materials.truncate(kept);
         self.supports.truncate(kept);
+        self.pressures.truncate(kept);
         self.ids.truncate(kept);
         gone.sort_unstable();
         self.ascending.retain(|id| gone.binary_search(id).is_err());

@@ -6,9 +6,15 @@
 //! (from M(x − s)/Δt² = k·Σ_i (P_i − x), the global step at its fixed point). The symmetric SPH
 //! pressure force particle i's pressure p_i exerts on j is m²·(p_i/ρ0²)·∇W(x_i − x_j). Equating
 //! the two gives p_i = −k·λ_i·w_j/V with V = m/ρ0; with w_j ≈ w_i this is the per-particle
-//! estimate p_i = −k·λ_i·w_i/V, λ_i being the local step's multiplier at the current positions.
-//! It is a reading of the constraint forces (their magnitude is set by the force balance, not
-//! by an equation of state), and as such needs a tight outer tolerance to be accurate.
+//! estimate p_i = −k·λ_i·w_i/V. It is a reading of the constraint forces (their magnitude is
+//! set by the force balance, not by an equation of state).
+//!
+//! The step's iteration rarely ends at that fixed point, so k·λ_i is taken from the
+//! multipliers the last step carried through its iteration (docs/method.md §10.1): what its
+//! constraints did over the whole step, wherever the iteration stopped. Where the last step
+//! did not carry them (the warm start, the coarse correction, the GPU backend) or particles
+//! were added or moved since, λ_i is the multiplier of a local step at the current positions,
+//! which needs a tight outer tolerance to be accurate.
 
 use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::world::Snapshot;
@@ -48,8 +54,20 @@ impl World {
 
     /// The pressure estimate (Pa) of every fluid particle of `snapshot`, in its order, and the
     /// mean vertical constraint force per particle (N). Runs on the caller's thread pool.
+    /// The pressures are the last step's, carried through its iteration, where it kept them
+    /// and nothing moved or added particles since; else they are read from a local step at
+    /// the current positions (see the module docs).
     pub(crate) fn pressure_field(&self, snapshot: &Snapshot) -> (Vec<f64>, f64) {
-        self.with_neighborhood(snapshot, |nb| self.pressures_in(&snapshot.fluid, nb))
+        let (pressures, support) =
+            self.with_neighborhood(snapshot, |nb| self.pressures_in(&snapshot.fluid, nb));
+        let carried = &self.fluid.pressures;
+        if carried.len() == self.fluid.len() && snapshot.fluid_order.len() == carried.len() {
+            let pressures = (snapshot.fluid_order.iter())
+                .map(|&slot| carried[slot as usize])
+                .collect();
+            return (pressures, support);
+        }
+        (pressures, support)
     }
 
     /// The pressure estimates (Pa) of the fluid particles at `x` with neighbourhood `nb`, and

@@ -7,7 +7,7 @@
 //! over from s without it.
 
 use super::search::Prediction;
-use super::{StepBuffers, coarse, couple, warm_start};
+use super::{StepBuffers, carry, coarse, couple, warm_start};
 use crate::boundary::Boundary;
 use crate::constraint::{CHUNK, DensityConstraint, Neighborhood, Projection, weigh_by_inertia};
 use crate::fluid::Fluid;
@@ -124,6 +124,10 @@ pub(super) fn iterate(
     };
     chebyshev.reset();
     b.coarse.start_step();
+    b.carry.start(b.current.len())?;
+    if !b.start_offsets.is_empty() {
+        b.carry.abandon();
+    }
     let mut accelerate = params.solver == SolverKind::Chebyshev;
     // The ρ_c the step extrapolates with (reported also where it falls back).
     let rho = if accelerate { chebyshev.rho() } else { 0.0 };
@@ -162,6 +166,7 @@ pub(super) fn iterate(
             if couple {
                 b.coupling.restart();
             }
+            b.carry.restart();
             // The online estimate learns from the extrapolated pass before it is dropped.
             chebyshev.finish_step(&b.displacements);
             (accelerate, k, displacement) = (false, 0, f64::INFINITY);
@@ -188,6 +193,7 @@ pub(super) fn iterate(
             };
             let (current, previous) = (&mut b.current, &mut b.previous);
             if b.coarse.correct(current, previous, &fluid)? {
+                b.carry.abandon();
                 constraint.project(&b.current, &nb, &mut b.projections, &mut b.corrections)?;
                 t_local = t.elapsed().as_secs_f64();
             }
@@ -265,6 +271,14 @@ pub(super) fn iterate(
             displacement = max_distance(&b.next, &b.current);
         }
         b.displacements.push(displacement);
+        b.carry.advance(&carry::Advance {
+            constraint,
+            lists: &b.fluid_lists,
+            corrections: &b.corrections,
+            system: &b.system,
+            dt2k,
+            chebyshev: extrapolation,
+        });
 
         // Rotate: X^(k−1) ← X^(k) ← X^(k+1) (which the fused sweep left in `previous`).
         std::mem::swap(&mut b.previous, &mut b.current);

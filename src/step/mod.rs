@@ -9,6 +9,7 @@
 //! reservation, a rebuilt grid, kept corrections, the body coupling's slots, a factorisation
 //! — fails before it moves the fluid, and puts back what it changed until then ([`undo`]).
 
+mod carry;
 mod coarse;
 mod couple;
 mod finish;
@@ -77,6 +78,9 @@ pub(crate) struct StepBuffers {
     coarse: coarse::CoarseCorrection,
     /// Every slot's mass m_i = ρ0_i·V (kg), from its material (docs/method.md §14).
     masses: Vec<f64>,
+    /// The multipliers carried through the iteration, for the step's pressures
+    /// (docs/method.md §10.1).
+    carry: carry::Carry,
 }
 
 /// Everything one time step reads and writes, borrowed from the world that owns it.
@@ -147,6 +151,9 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             boundary.place_moving(grid, moving_particles(bodies))?;
         }
         search::search(grid, boundary, params.support_radius(), buffers)?;
+        // Room for the pressures the step's end writes (docs/method.md §10.1).
+        let n = fluid.len();
+        crate::reserve::reserve_total(&mut fluid.pressures, n)?;
         slot_masses(
             constraint.mass,
             &materials.mass_ratios,
@@ -207,6 +214,8 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
             warm_start::record(&mut supports, x, predicted, dt, lists, corrections, limit);
             fluid.supports = supports;
         }
+        let lists = &buffers.fluid_lists;
+        (buffers.carry).pressures(constraint, lists, dt, &mut fluid.pressures);
         if couple {
             let loads = &mut buffers.loads;
             let predicted = &search::Prediction::new(fluid, None, dt, gravity);

@@ -327,6 +327,7 @@ impl World {
         });
         if let Some(settled) = settled {
             self.fluid.positions = settled;
+            self.fluid.pressures.clear();
         }
         self.fluid.densities = self.densities_now();
     }

@@ -266,6 +266,7 @@ impl World {
         fluid.velocities = state.velocities;
         fluid.densities = state.densities;
         fluid.supports = state.supports;
+        fluid.pressures.clear();
         fluid.materials = state.materials;
         fluid.ids = state.ids;
         fluid.ascending = ascending;

@@ -32,9 +32,10 @@ pub struct ConstraintPressures {
 }
 
 impl World {
-    /// The pressure estimate p_i = −k·λ_i·w_i/V (Pa) of every fluid particle at its current
-    /// position (see the module docs), with that position; and the mean vertical constraint
-    /// force per particle (N).
+    /// The pressure estimate p_i = −k·λ_i·w_i/V (Pa) of every fluid particle, from the
+    /// multipliers the last step carried (or a local step at the current positions, see the
+    /// module docs), with its position; and the mean vertical constraint force per particle
+    /// at the current positions (N).
     ///
     /// # Panics
     /// When memory for the neighbour lists and projections cannot be had (a reading for

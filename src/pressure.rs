@@ -59,15 +59,15 @@ impl World {
     /// and nothing moved or added particles since; else they are read from a local step at
     /// the current positions (see the module docs).
     pub(crate) fn pressure_field(&self, snapshot: &Snapshot) -> (Vec<f64>, f64) {
-        let (pressures, support) =
+        let (local, support) =
             self.with_neighborhood(snapshot, |nb| self.pressures_in(&snapshot.fluid, nb));
         let carried = &self.fluid.pressures;
-        if carried.len() == self.fluid.len() && snapshot.fluid_order.len() == carried.len() {
-            let pressures = (snapshot.fluid_order.iter())
-                .map(|&slot| carried[slot as usize])
-                .collect();
-            return (pressures, support);
-        }
+        let pressures = if carried.len() == self.fluid.len() {
+            let slots = snapshot.fluid_order.iter();
+            slots.map(|&slot| carried[slot as usize]).collect()
+        } else {
+            local
+        };
         (pressures, support)
     }
 

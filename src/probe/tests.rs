@@ -660,10 +660,10 @@ fn documented_probes_example_is_valid() {
 /// (docs/method.md §10.1), so a tank at rest reads ρ0·g·depth at the calm settings' own τ,
 /// without the tight reading solve, and at a stiff k as at the default one: probes in the
 /// fluid and on a side wall within 5 %, on the floor within 8 % (measured: 0.997–1.008, 1.012
-/// and 0.951 at the default k; 0.962–0.995, 0.991 and 0.930 at k = 10⁶ N/m). A local step at the current positions, the reading
-/// for worlds whose last step carried nothing, is off by far more at k = 10⁶ N/m (0.44 to 6.4
-/// of it, measured): there the step ends near the hard-constraint solution, far from the
-/// penalty's fixed point that reading assumes.
+/// and 0.951 at the default k; 0.962–0.995, 0.991 and 0.930 at k = 10⁶ N/m). A local step at
+/// the current positions, the reading for worlds whose last step carried nothing, is off by
+/// far more at k = 10⁶ N/m (0.44 to 6.4 of it, measured): there the step ends near the
+/// hard-constraint solution, far from the penalty's fixed point that reading assumes.
 #[test]
 fn carried_pressures_need_no_tight_solve_and_hold_at_a_stiff_k() {
     for stiffness in [Params::default().stiffness, 1e6] {

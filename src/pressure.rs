@@ -19,6 +19,7 @@
 use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::world::Snapshot;
 use crate::{Vec3, World};
+use rayon::prelude::*;
 
 /// Pressures estimated from the constraint forces at the current positions.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -59,20 +60,39 @@ impl World {
     /// and nothing moved or added particles since; else they are read from a local step at
     /// the current positions (see the module docs).
     pub(crate) fn pressure_field(&self, snapshot: &Snapshot) -> (Vec<f64>, f64) {
-        let (local, support) =
-            self.with_neighborhood(snapshot, |nb| self.pressures_in(&snapshot.fluid, nb));
         let carried = &self.fluid.pressures;
-        let pressures = if carried.len() == self.fluid.len() {
-            let slots = snapshot.fluid_order.iter();
-            slots.map(|&slot| carried[slot as usize]).collect()
-        } else {
-            local
-        };
-        (pressures, support)
+        self.with_neighborhood(snapshot, |nb| {
+            if carried.len() == self.fluid.len() {
+                let slots = snapshot.fluid_order.iter();
+                let pressures: Vec<f64> = slots.map(|&slot| carried[slot as usize]).collect();
+                let support = self.mean_vertical_force(&snapshot.fluid, nb, &pressures);
+                (pressures, support)
+            } else {
+                self.pressures_in(&snapshot.fluid, nb)
+            }
+        })
+    }
+
+    /// The mean vertical constraint force per particle (N) of the fluid particles at `x` with
+    /// neighbourhood `nb` whose constraints hold `pressures` (Pa): k·λ_i = −p_i·V/μ_i, and
+    /// constraint i pushes the fluid with k·λ_i·Σ_j w_j ∇_{x_j} C_i.
+    fn mean_vertical_force(&self, x: &[Vec3], nb: &Neighborhood, pressures: &[f64]) -> f64 {
+        let c = &self.constraint;
+        let volume = c.mass / c.rest_density;
+        let force_sum: f64 = (0..x.len())
+            .into_par_iter()
+            .map_init(Vec::new, |grads, i| {
+                let k_lambda = -pressures[i] * volume / c.membership(nb.fluid, i);
+                k_lambda * c.weighted_gradient_sum(i, x, nb, grads).y
+            })
+            .collect::<Vec<f64>>()
+            .iter()
+            .sum();
+        force_sum / x.len().max(1) as f64
     }
 
     /// The pressure estimates (Pa) of the fluid particles at `x` with neighbourhood `nb`, and
-    /// the mean vertical constraint force per particle (N).
+    /// the mean vertical constraint force per particle (N), from a local step at `x`.
     fn pressures_in(&self, x: &[Vec3], nb: &Neighborhood) -> (Vec<f64>, f64) {
         let params = &self.params;
         let c = &self.constraint;

@@ -19,9 +19,9 @@ pub struct Corrections {
     /// Segment k spans `data[offsets[k]..offsets[k + 1]]`.
     pub(super) offsets: Vec<u32>,
     pub(super) data: Vec<Vec3>,
-    /// λ_i of every projection's first step, 0 for an inactive constraint, in a compact array
-    /// (8 bytes per particle, against 40 for a [`Projection`]): the gather reads it for
-    /// every neighbour that `moved` marks.
+    /// λ_i of every projection, the sum over its Newton steps (one, usually), 0 for an
+    /// inactive constraint, in a compact array (8 bytes per particle, against 40 for a
+    /// [`Projection`]): the gather reads it for every neighbour that `moved` marks.
     pub(super) lambdas: Vec<f64>,
     /// 1 where a single-step projection moved its stencil (λ not 0): one byte per particle,
     /// so that the gather's scan of a particle's neighbours reads an array that stays in the
@@ -53,8 +53,8 @@ impl Corrections {
         self.owners.len()
     }
 
-    /// λ of the first step of projection i in the last local step (m²; 0 for an inactive
-    /// constraint).
+    /// λ of projection i in the last local step, summed over its Newton steps (m²; 0 for an
+    /// inactive constraint).
     pub fn lambda(&self, i: usize) -> f64 {
         self.lambdas[i]
     }

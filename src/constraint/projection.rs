@@ -130,6 +130,26 @@ impl DensityConstraint {
         })
     }
 
+    /// Σ_j w_j ∇_{x_j} C_i (1/m) over the fluid members j of constraint i's stencil, i
+    /// included, at positions `x`: multiplied by k·λ_i (N·m), the force constraint i exerts
+    /// on the fluid (docs/method.md §10.1). `grads` is scratch room.
+    pub(crate) fn weighted_gradient_sum(
+        &self,
+        i: usize,
+        x: &[Vec3],
+        nb: &Neighborhood,
+        grads: &mut Vec<Vec3>,
+    ) -> Vec3 {
+        let members = nb.fluid.of(i);
+        let (grad_i, _) = self.gradients(i, x[i], |s| x[members[s] as usize], nb, grads);
+        grads
+            .iter()
+            .zip(members)
+            .fold(grad_i * self.weight_of(nb, i), |sum, (g, &j)| {
+                sum + g * self.weight_of(nb, j as usize)
+            })
+    }
+
     /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary
     /// particles are not unknowns); `grads[s]` receives ∇_{p_j} C_i = −(m/ρ0)∇W(p_i − p_j)
     /// for the s-th fluid neighbour at `neighbor(s)`.
@@ -192,10 +212,11 @@ impl DensityConstraint {
 
     crate::simd::avx2_dispatch! {
         /// Projection of constraint i (docs/method.md §2.5): Newton-like steps on a private
-        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14; returns the first step's λ
-        /// (m², 0 for an inactive constraint). A projection that ends after its first step
-        /// is recorded by λ alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour)
-        /// receive the corrections. The AVX2 build runs the loops over a stencil's members
+        /// copy p = x + dp of the stencil until C_i(p) ≤ 1e-14; returns the sum of its
+        /// steps' λ (m², 0 for an inactive constraint), the multiplier the step carries for
+        /// its pressures. A projection that ends after its first step is recorded by that λ
+        /// alone; otherwise `dp[0]` (i) and `dp[s + 1]` (s-th neighbour) receive the
+        /// corrections. The AVX2 build runs the loops over a stencil's members
         /// four lanes wide, bitwise alike (tested).
         fn project_one / project_one_avx2(
             &self,
@@ -220,7 +241,7 @@ impl DensityConstraint {
         scratch: &mut Scratch,
     ) -> f64 {
         *out = Projection::default();
-        let mut first_lambda = 0.0;
+        let (mut first_lambda, mut total_lambda) = (0.0, 0.0);
         let members = nb.fluid.of(i);
         let at = |s: usize| x[members[s] as usize];
         let w = |s: usize| self.weight_of(nb, members[s] as usize);
@@ -271,6 +292,7 @@ impl DensityConstraint {
                 lambda = self.bounded_newton_step(lambda, grad_i * w_i, &scratch.grads, w);
             }
             out.self_correction += grad_i * (lambda * w_i);
+            total_lambda += lambda;
             if step == 0 && !self.evaluate_first_step && !self.materialize_all {
                 relaxes = self.first_step_surely_relaxes(rho, lambda, grad_i, w_i, scratch);
             }
@@ -284,6 +306,6 @@ impl DensityConstraint {
             }
         }
         out.materialized = materialized;
-        first_lambda
+        total_lambda
     }
 }

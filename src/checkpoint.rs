@@ -6,16 +6,18 @@
 //! masses) from the scene, so a body's mesh file must still be readable, and their poses,
 //! velocities and loads from the state.
 //!
-//! Layout: the magic `PFCHECK5`; the length (u64, little-endian) of a JSON header, the
+//! Layout: the magic `PFCHECK6`; the length (u64, little-endian) of a JSON header, the
 //! header ([`header`]: the scene with the world's parameters, time, step count, next Δt,
 //! containers (and which of them have walls that are fields), grid, counts, the run's end,
 //! the online ρ_c estimate, the bodies' poses, velocities and loads, the next particle id,
 //! the removed count, sinks, domain and emitters); the fluid positions, velocities,
 //! supports (docs/method.md §4.1; zeros while the warm start is off) and densities as f64
 //! triples/values, the particle ids as u64, their materials as u16 (the header lists the
-//! materials, docs/method.md §14), the static boundary positions as f64 triples
-//! and their owners as u32 (all little-endian); and a SHA-256 digest of everything before
-//! it, so that a damaged or truncated file is refused.
+//! materials, docs/method.md §14), the pressures the last step carried as f64 where the
+//! header says it carried them (docs/method.md §10.1), the static boundary positions as f64
+//! triples and their owners as u32 (all little-endian); and a SHA-256 digest of everything
+//! before it, so that a damaged or truncated file is refused. A `PFCHECK5` checkpoint, the
+//! same without pressures, resumes as well.
 
 mod header;
 
@@ -26,7 +28,9 @@ use serde::{Deserialize, Serialize};
 use sha2::{Digest, Sha256};
 use std::path::Path;
 
-const MAGIC: &[u8; 8] = b"PFCHECK5";
+const MAGIC: &[u8; 8] = b"PFCHECK6";
+/// The format before the carried pressures, which resumes without them.
+const MAGIC_V5: &[u8; 8] = b"PFCHECK5";
 /// The magics of earlier formats, named in the errors that refuse them: before bodies,
 /// before particle ids, sinks and emitters, before the warm start's supports, and before
 /// materials.
@@ -98,6 +102,7 @@ pub fn write_checkpoint(
             .filter_map(|m| world.material(m as u16))
             .map(|m| m.kinematic_viscosity)
             .collect(),
+        pressures: !state.pressures.is_empty(),
     };
     let json = serde_json::to_vec(&header)
         .map_err(|e| Error::Io(format!("cannot encode checkpoint header: {e}")))?;
@@ -124,6 +129,9 @@ pub fn write_checkpoint(
     }
     for m in &f.materials {
         bytes.extend_from_slice(&m.to_le_bytes());
+    }
+    for p in &f.pressures {
+        bytes.extend_from_slice(&p.to_le_bytes());
     }
     for p in &f.boundary_positions {
         push_vec3(&mut bytes, p);
@@ -183,7 +191,8 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
              version cannot resume",
         ));
     }
-    if bytes.len() < MAGIC.len() || &bytes[..MAGIC.len()] != MAGIC {
+    let earlier = bytes.starts_with(MAGIC_V5);
+    if !(bytes.starts_with(MAGIC) || earlier) {
         return Err(bad("is not a projfluid checkpoint (wrong magic bytes)"));
     }
     if bytes.len() < MAGIC.len() + 8 + DIGEST_LEN {
@@ -207,9 +216,15 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     }
     let header: Header = serde_json::from_slice(&body[16..header_end])
         .map_err(|e| bad(&format!("has an unreadable header: {e}")))?;
+    if earlier && header.pressures {
+        return Err(bad(
+            "is inconsistent: a checkpoint of the format before pressures announces pressures",
+        ));
+    }
     let (n, m) = (header.fluid_count, header.boundary_count);
+    let pressure_bytes = if header.pressures { 8 } else { 0 };
     let expected = n
-        .checked_mul(3 * 8 * 3 + 8 + 8 + 2)
+        .checked_mul(3 * 8 * 3 + 8 + 8 + 2 + pressure_bytes)
         .and_then(|f| m.checked_mul(24 + 4).and_then(|b| f.checked_add(b)));
     if expected != Some(body.len() - header_end) {
         return Err(bad(&format!(
@@ -233,6 +248,10 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
     let densities: Vec<f64> = (0..n).map(|_| f64::from_le_bytes(data.take())).collect();
     let ids: Vec<u64> = (0..n).map(|_| u64::from_le_bytes(data.take())).collect();
     let materials: Vec<u16> = (0..n).map(|_| u16::from_le_bytes(data.take())).collect();
+    let pressures: Vec<f64> = match header.pressures {
+        true => (0..n).map(|_| f64::from_le_bytes(data.take())).collect(),
+        false => Vec::new(),
+    };
     let boundary = data.vec3s(m);
     let owners: Vec<u32> = (0..m).map(|_| u32::from_le_bytes(data.take())).collect();
     let bodies = header
@@ -250,6 +269,7 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         supports,
         densities,
         materials,
+        pressures,
         ids,
         next_id: header.next_id,
         removed_count: header.removed_count,

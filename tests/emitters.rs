@@ -441,6 +441,14 @@ fn misuse_is_rejected_and_changes_nothing() {
     bad.supports = vec![Vec3::new(0.0, f64::NAN, 0.0); bad.positions.len()];
     let message = world.import_state(bad).unwrap_err().to_string();
     assert!(message.contains("state.supports"), "{message}");
+    let mut bad = before.clone();
+    bad.pressures = vec![0.0; bad.positions.len() + 1];
+    let message = world.import_state(bad).unwrap_err().to_string();
+    assert!(message.contains("state.pressures"), "{message}");
+    let mut bad = before.clone();
+    bad.pressures = vec![f64::INFINITY; bad.positions.len()];
+    let message = world.import_state(bad).unwrap_err().to_string();
+    assert!(message.contains("state.pressures"), "{message}");
     assert_eq!(world.export_state(), before);
 }
 

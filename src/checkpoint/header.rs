@@ -45,6 +45,10 @@ pub(super) struct Header {
     /// none beyond the parameters' (`kinematic_viscosity`) for the world's own fluid.
     #[serde(default)]
     pub viscosities: Vec<f64>,
+    /// Whether the particle data holds the pressures the last step carried (absent, and no
+    /// pressures, in checkpoints written before they were saved).
+    #[serde(default)]
+    pub pressures: bool,
 }
 
 /// A box as its lower and upper corners (m).

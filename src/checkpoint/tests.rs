@@ -320,6 +320,72 @@ fn a_resumed_world_keeps_its_emitters_sinks_and_ids() {
     assert_eq!(resumed.export_state(), reference.export_state());
 }
 
+/// The pressures the last step carried are part of the state: a resumed world reads the
+/// pressures of the uninterrupted one, bit for bit, where a world that forgot them reads a
+/// local step's (docs/method.md §10.1).
+#[test]
+fn a_resumed_world_reads_the_pressures_of_the_uninterrupted_one() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    for _ in 0..15 {
+        reference.step().unwrap();
+    }
+    assert_eq!(reference.fluid.pressures.len(), reference.fluid_count());
+    let path = temp("pressures.pfck");
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    let resumed = read_checkpoint(&path, None).unwrap().world;
+    let mut forgetful = read_checkpoint(&path, None).unwrap().world;
+    std::fs::remove_file(&path).unwrap();
+    forgetful.fluid.pressures.clear();
+    let expected = reference.constraint_pressures();
+    assert!(expected.samples.iter().any(|(_, p)| *p > 100.0));
+    assert_eq!(resumed.constraint_pressures(), expected);
+    assert_ne!(forgetful.constraint_pressures(), expected);
+}
+
+/// Gives the checkpoint at `path` the magic of the format before the carried pressures, with
+/// its digest recomputed.
+fn relabel_as_v5(path: &std::path::Path) {
+    let mut bytes = std::fs::read(path).unwrap();
+    bytes[..8].copy_from_slice(MAGIC_V5);
+    let body = bytes.len() - DIGEST_LEN;
+    let digest = Sha256::digest(&bytes[..body]);
+    bytes[body..].copy_from_slice(&digest);
+    std::fs::write(path, &bytes).unwrap();
+}
+
+/// A checkpoint of the format before the carried pressures (`PFCHECK5`: the same without
+/// them) resumes, continuing bit for bit, and reads its pressures from a local step until
+/// its next step carries them; one of that format that announces pressures is refused.
+#[test]
+fn a_checkpoint_without_pressures_resumes() {
+    let scene = small_scene();
+    let mut reference = scene.build_world().unwrap();
+    let mut bare = scene.build_world().unwrap();
+    for _ in 0..10 {
+        reference.step().unwrap();
+        bare.step().unwrap();
+    }
+    bare.fluid.pressures.clear();
+    let path = temp("v5.pfck");
+    write_checkpoint(&path, &scene, &bare, None).unwrap();
+    relabel_as_v5(&path);
+    let mut resumed = read_checkpoint(&path, None).unwrap().world;
+    assert!(resumed.fluid.pressures.is_empty());
+    for _ in 0..5 {
+        reference.step().unwrap();
+        resumed.step().unwrap();
+    }
+    assert_eq!(resumed.positions_hash(), reference.positions_hash());
+    assert_eq!(resumed.fluid.pressures, reference.fluid.pressures);
+
+    write_checkpoint(&path, &scene, &reference, None).unwrap();
+    relabel_as_v5(&path);
+    let message = read_checkpoint(&path, None).err().unwrap().to_string();
+    std::fs::remove_file(&path).unwrap();
+    assert!(message.contains("announces pressures"), "{message}");
+}
+
 /// A checkpoint of an earlier format is refused with a message saying what it lacks.
 #[test]
 fn checkpoints_of_earlier_formats_are_refused() {

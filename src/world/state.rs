@@ -39,6 +39,10 @@ pub struct WorldState {
     pub supports: Vec<Vec3>,
     /// Each fluid particle's material (docs/method.md §14), one of the world's.
     pub materials: Vec<crate::material::MaterialId>,
+    /// The pressure (Pa) of each fluid particle that the last step carried through its
+    /// iteration (docs/method.md §10.1), which the pressure readings return: empty where
+    /// the last step carried none.
+    pub pressures: Vec<f64>,
     /// Each stored fluid particle's id (docs/method.md §12.1): unique, below `next_id`.
     pub ids: Vec<u64>,
     /// The id the next added particle gets: the number of particles ever added.
@@ -100,6 +104,7 @@ impl World {
             densities: fluid.densities.clone(),
             supports: fluid.supports.clone(),
             materials: fluid.materials.clone(),
+            pressures: fluid.pressures.clone(),
             ids: fluid.ids.clone(),
             next_id: fluid.next_id,
             removed_count: fluid.removed,
@@ -157,6 +162,16 @@ impl World {
             ));
         }
         super::check_finite("state.supports", &state.supports)?;
+        if !state.pressures.is_empty() && state.pressures.len() != n {
+            return Err(Error::invalid(
+                "state.pressures",
+                state.pressures.len(),
+                &format!("must be empty or hold one pressure per particle ({n})"),
+            ));
+        }
+        if let Some(p) = state.pressures.iter().find(|p| !p.is_finite()) {
+            return Err(Error::invalid("state.pressures", p, "must be finite (Pa)"));
+        }
         let emitted = state.emitters.iter().map(|e| &e.material);
         for (name, &m) in std::iter::repeat("state.materials")
             .zip(&state.materials)
@@ -266,7 +281,7 @@ impl World {
         fluid.velocities = state.velocities;
         fluid.densities = state.densities;
         fluid.supports = state.supports;
-        fluid.pressures.clear();
+        fluid.pressures = state.pressures;
         fluid.materials = state.materials;
         fluid.ids = state.ids;
         fluid.ascending = ascending;

@@ -29,6 +29,9 @@ pub(crate) struct Undo {
     fluid: (usize, u64),
     /// Every emitter's progress before it inserted its due layers.
     emitters: Vec<EmitterState>,
+    /// The pressures the last step carried (docs/method.md §10.1), which the fluid gives up
+    /// while the step runs; its own vector holds this one's room meanwhile.
+    pressures: Vec<f64>,
 }
 
 impl Undo {
@@ -45,18 +48,22 @@ impl Undo {
         reserve_total(&mut self.emitters, emitters)
     }
 
-    /// Keeps the fluid's size and the emitters' progress before the emitters insert the
-    /// layers due at the start of a step (in the room reserved).
-    pub(crate) fn before_emission(&mut self, fluid: &Fluid, emitters: &[Emitter]) {
+    /// Keeps the fluid's size, its carried pressures (moved here, the fluid left without
+    /// any) and the emitters' progress before the emitters insert the layers due at the
+    /// start of a step (in the room reserved).
+    pub(crate) fn before_emission(&mut self, fluid: &mut Fluid, emitters: &[Emitter]) {
         self.fluid = (fluid.len(), fluid.next_id);
+        std::mem::swap(&mut self.pressures, &mut fluid.pressures);
+        fluid.pressures.clear();
         self.emitters.clear();
         self.emitters.extend(emitters.iter().map(|e| *e.state()));
     }
 
     /// Removes the particles the emitters inserted since [`Undo::before_emission`] and puts
-    /// their progress back.
-    pub(crate) fn undo_emission(&self, fluid: &mut Fluid, emitters: &mut [Emitter]) {
+    /// their progress and the fluid's pressures back.
+    pub(crate) fn undo_emission(&mut self, fluid: &mut Fluid, emitters: &mut [Emitter]) {
         fluid.truncate(self.fluid.0, self.fluid.1);
+        std::mem::swap(&mut self.pressures, &mut fluid.pressures);
         for (emitter, state) in emitters.iter_mut().zip(&self.emitters) {
             emitter.restore(state);
         }

@@ -168,7 +168,7 @@ impl World {
     pub(super) fn start_step(&mut self) -> Result<(), std::collections::TryReserveError> {
         self.buffers
             .undo
-            .before_emission(&self.fluid, &self.emitters);
+            .before_emission(&mut self.fluid, &self.emitters);
         let emitted = self.emit();
         if emitted.is_err() {
             self.buffers

@@ -59,6 +59,9 @@ pub(crate) struct Readback {
     pub positions: Vec<Vec3>,
     pub velocities: Vec<Vec3>,
     pub densities: Vec<f64>,
+    /// The pressure each particle's constraint carried through the step's iteration (Pa,
+    /// docs/method.md §10.1).
+    pub pressures: Vec<f64>,
     /// The index, in the arrays last uploaded, of the particle in each slot.
     pub order: Vec<u32>,
 }
@@ -260,7 +263,7 @@ impl GpuStepper {
     /// The device's position buffer after the last step, in the device's order of the
     /// particles ([`Readback::order`]), with their count and the point the positions are
     /// measured from (m, world frame): one `vec4<f32>` per particle, x, y, z in metres from
-    /// that point and w unused.
+    /// that point and w the pressure the step carried (Pa).
     pub fn positions(&self) -> (&wgpu::Buffer, u32, Vec3) {
         (&self.buffers.x, self.buffers.n, self.grid.centre)
     }
@@ -279,6 +282,10 @@ impl GpuStepper {
                 .map(|v| Vec3::new(v[0].into(), v[1].into(), v[2].into()))
                 .collect(),
             densities: floats(&parts[2]).into_iter().map(f64::from).collect(),
+            pressures: floats(&parts[0])
+                .chunks_exact(4)
+                .map(|p| f64::from(p[3]))
+                .collect(),
             order: words(&parts[3]),
         }
     }

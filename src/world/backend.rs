@@ -225,7 +225,7 @@ impl World {
         fluid.velocities = back.velocities;
         fluid.densities = back.densities;
         fluid.supports.clear();
-        fluid.pressures.clear();
+        fluid.pressures = back.pressures;
         let inflow_dt = crate::step::cfl_step(&self.params, inflow);
         Ok((stats, next_dt.min(inflow_dt)))
     }

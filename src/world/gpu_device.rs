@@ -9,8 +9,9 @@ use crate::{Backend, Error, Vec3};
 /// The fluid's positions on the device after the last step ([`World::gpu_positions`]).
 #[derive(Clone, Copy, Debug)]
 pub struct GpuPositions<'a> {
-    /// One `vec4<f32>` per particle (16 bytes): x, y and z in metres from [`origin`], w
-    /// unused. Particles lie in the device's order, which the steps change. Its usages
+    /// One `vec4<f32>` per particle (16 bytes): x, y and z in metres from [`origin`], and
+    /// in w the particle's pressure in pascals, as [`World::constraint_pressures`] reads it
+    /// after a step (for colouring by pressure). Particles lie in the device's order, which the steps change. Its usages
     /// are `STORAGE`, `COPY_SRC` and `COPY_DST`: bind it read-only as a storage buffer (in
     /// a vertex shader, for instance), or copy it.
     ///

@@ -35,7 +35,8 @@ fn update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: v
     }
     let p = result[i].xyz;
     velocity[i] = vec4<f32>((p - x[i].xyz) / P.gravity.w, 0.0);
-    x[i] = vec4<f32>(p, 0.0);
+    // The pressure the iteration carried (sweep.wgsl) rides along in x's fourth component.
+    x[i] = vec4<f32>(p, result[i].w);
     if I.densities_known == 0u {
         var fluid = 0.0;
         for (var e = fluid_offset[i]; e < fluid_offset[i + 1u]; e++) {

@@ -113,6 +113,8 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
     let w_i = weight(members, material[i]);
     var own = vec3<f32>(0.0);
     var first_lambda = 0.0;
+    // The sum of every step's λ: the multiplier the step carries (sweep.wgsl).
+    var total_lambda = 0.0;
     var materialized = false;
     for (var step = 0u; step < MAX_PROJECTION_STEPS; step++) {
         let pi = xi + own;
@@ -170,10 +172,11 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
             first_lambda = lambda;
         }
         own += g.own * (lambda * w_i);
+        total_lambda += lambda;
         if materialized {
             kept.entries[seg] = vec4<f32>(own, 0.0);
         }
     }
-    projection[i] = vec4<f32>(own, first_lambda);
+    projection[i] = vec4<f32>(own, total_lambda);
     flags[i] = select(0u, seg + 1u, materialized);
 }

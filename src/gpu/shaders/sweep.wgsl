@@ -1,7 +1,9 @@
 // The global step on the diagonal system (docs/method.md §3.1, §3.6) fused with the gather
 // of the local step's corrections and Chebyshev's extrapolation (§3.7), as
 // src/solver/sweep.rs: X^(k+1) replaces X^(k−1) in place, and |X^(k+1) − X^(k)| goes to
-// values.y for the displacement rule (§4). ω and whether to extrapolate are the schedule's
+// values.y for the displacement rule (§4). The iterates' fourth component carries the
+// particle's pressure through the same recurrence (src/step/carry.rs, §10.1): Λ_j scaled by
+// −ρ0·μ_j/(Δt²·c_j), constant within a step, so that the result holds p_j = −k·λ_j·μ_j/V. ω and whether to extrapolate are the schedule's
 // for the iteration k (control.wgsl). Nothing is written once the outer iteration has stopped,
 // nor where the local step found its pool of kept corrections full (project.wgsl): the host
 // then grows the pool and takes the outer iteration again.
@@ -88,17 +90,20 @@ fn sweep(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: ve
     // X + (b − Â X)/Â with b − Â X = m(s − X) + Δt²k·scale·gathered, which keeps single
     // precision where b and Â X nearly cancel.
     let residual = P.mass * (s[j].xyz - x) + gathered(j, x, count) * (P.dt2k * scale);
-    var plain = x + residual / diagonal;
-    let before = previous[j].xyz;
+    let dt = P.gravity.w;
+    let source = -projection[j].w * P.rest_density * members / (dt * dt);
+    let here = vec4<f32>(x, current[j].w);
+    var plain = vec4<f32>(x + residual / diagonal, P.dt2k * (members * here.w + source) / diagonal);
+    let before = previous[j];
     let step = schedule[kept.k];
     let omega = step.x;
     if step.y != 0.0 {
         if I.gamma == 1.0 {
             plain = plain + (plain - before) * (omega - 1.0);
         } else {
-            plain = before + ((plain - x) * I.gamma + x - before) * omega;
+            plain = before + ((plain - here) * I.gamma + here - before) * omega;
         }
     }
-    previous[j] = vec4<f32>(plain, 0.0);
-    values[j].y = length(plain - x);
+    previous[j] = plain;
+    values[j].y = length(plain.xyz - x);
 }

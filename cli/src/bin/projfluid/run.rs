@@ -351,15 +351,15 @@ fn apply_overrides(scene: &mut Scene, args: &RunArgs) -> Result<RunLength, Failu
 
 /// Pressure probes read the constraint forces of each step (docs/method.md §10.3). With the
 /// density rule on, a step ends as soon as the compression is small and single readings
-/// scatter; where the last step cannot carry its forces (the warm start, the coarse correction,
-/// the GPU backend) they are read from a local step, which also needs a tight τ. Says so on
+/// scatter; where the last step cannot carry its forces (the warm start, the coarse
+/// correction) they are read from a local step, which also needs a tight τ. Says so on
 /// stderr when a run with pressure probes is solved more loosely than that.
 fn warn_about_loose_pressure_readings(scene: &Scene, world: &projfluid::World) {
     if scene.probes.as_ref().is_none_or(|p| p.pressure.is_empty()) {
         return;
     }
     let p = world.params();
-    let carried = p.warm_start == 0.0 && !p.coarse_correction && p.backend == Backend::Cpu;
+    let carried = p.warm_start == 0.0 && !p.coarse_correction;
     let tight = READING_TOLERANCE_PER_RADIUS * p.particle_radius;
     let loose_tau = !carried && p.displacement_tolerance > tight * (1.0 + 1e-9);
     if p.density_tolerance > 0.0 || loose_tau {

@@ -6,6 +6,7 @@ use crate::Vec3;
 use crate::params::{ChebyshevParams, Omega2Rule};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
+use std::ops::{Add, Mul, Sub};
 
 /// A step needs at least this many outer iterations to give an estimate of the plain
 /// iteration's contraction.
@@ -136,9 +137,14 @@ impl Chebyshev {
     }
 
     /// One particle of [`Chebyshev::extrapolate`]: X^(k+1) (m) from the plain iterate
-    /// `plain` = X̃^(k+1), `current` = X^(k) and `previous` = X^(k−1) (m), with weight `omega`.
+    /// `plain` = X̃^(k+1), `current` = X^(k) and `previous` = X^(k−1) (m), with weight `omega`;
+    /// the same for any quantity the iteration carries alike (a position, or a carried
+    /// multiplier in m²).
     #[inline]
-    pub fn extrapolated(&self, omega: f64, plain: Vec3, current: Vec3, previous: Vec3) -> Vec3 {
+    pub fn extrapolated<T>(&self, omega: f64, plain: T, current: T, previous: T) -> T
+    where
+        T: Copy + Add<Output = T> + Sub<Output = T> + Mul<f64, Output = T>,
+    {
         let gamma = self.params.gamma;
         if gamma == 1.0 {
             // Momentum form of the same update: X̃ + (ω − 1)(X̃ − X^(k−1)).

@@ -9,7 +9,6 @@
 //! ended: near the fixed point, as with a soft stiffness, or near the hard-constraint solution,
 //! as with a stiff one.
 
-use crate::Vec3;
 use crate::constraint::{Corrections, DensityConstraint};
 use crate::neighbors::NeighborLists;
 use crate::reserve::reserve_total;
@@ -81,10 +80,7 @@ impl Carry {
                 let plain = a.dt2k * (mu * *current + scale * lambda) / a.system.diagonal[j];
                 let next = match a.chebyshev {
                     Some((chebyshev, omega)) => {
-                        let at = |v: f64| Vec3::new(v, 0.0, 0.0);
-                        chebyshev
-                            .extrapolated(omega, at(plain), at(*current), at(*previous))
-                            .x
+                        chebyshev.extrapolated(omega, plain, *current, *previous)
                     }
                     None => plain,
                 };

@@ -53,8 +53,8 @@ const MAX_PROJECTION_STEPS: usize = 100;
 /// The local step and the gather take particles in runs of this many, each run with one
 /// borrow of the thread's buffers.
 pub(crate) const CHUNK: usize = 64;
-/// A Newton step of a projection after its first moves no stencil member farther than this
-/// fraction of H (= r). The constraint is far from linear over longer distances: where a
+/// No Newton step of a projection, its first included, moves a stencil member farther than
+/// this fraction of H (= r). The constraint is far from linear over longer distances: where a
 /// member presses on a boundary particle the gradient is nearly flat, and an unbounded step
 /// threw a member metres away (docs/method.md §2.5).
 const NEWTON_STEP_LIMIT: f64 = 0.25;

@@ -2,7 +2,7 @@
 //! stencil (docs/method.md §2.5), and what each projection produced ([`Projection`]).
 
 use super::gather::Corrections;
-use super::stencil::{SCRATCH, Scratch};
+use super::stencil::{Members, SCRATCH, Scratch};
 use super::{
     CHUNK, CONSTRAINT_GOAL, DensityConstraint, MAX_PROJECTION_STEPS, NEWTON_STEP_LIMIT,
     Neighborhood, REGULARIZATION,
@@ -196,12 +196,53 @@ impl DensityConstraint {
         grads: &[Vec3],
         w: impl Fn(usize) -> f64,
     ) -> f64 {
-        let largest = grads
+        let stride = grads
             .iter()
             .enumerate()
             .map(|(s, g)| g.norm() * w(s))
-            .fold(own.norm(), f64::max)
-            * lambda.abs();
+            .fold(own.norm(), f64::max);
+        self.bounded(lambda, stride)
+    }
+
+    /// λ of a projection's first Newton step, shortened so that the move the global step
+    /// makes of it moves no stencil member farther than [`NEWTON_STEP_LIMIT`]·H: member j's
+    /// correction λ·w_j·∇_{x_j}C_i is one of the n_j + 1 the global step averages, so it moves
+    /// j by about λ·w_j·|∇_{x_j}C_i|/(n_j + 1). `own` is particle i's weighted gradient and
+    /// `members` the members' gradients and weights that [`Self::first_gradients`] left.
+    #[inline(always)]
+    fn bounded_first_step(
+        &self,
+        lambda: f64,
+        own: Vec3,
+        members: &Members,
+        i: usize,
+        nb: &Neighborhood,
+    ) -> f64 {
+        let n = members.n;
+        let shares = |j: usize| (nb.fluid.count(j) + 1) as f64;
+        let limit = NEWTON_STEP_LIMIT * self.kernel.support_radius();
+        // w_j/(n_j + 1) ≤ w_j: a bound from the stencil's own arrays decides nearly every
+        // projection without reading the members' neighbour counts.
+        let largest_g2 = members.values[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
+        let largest_w = members.weights[..n].iter().fold(0.0, |a: f64, &b| a.max(b));
+        let own_share = own.norm() / shares(i);
+        if lambda.abs() * own_share.max(largest_g2.sqrt() * largest_w) <= limit {
+            return lambda;
+        }
+        let stride = members.values[..n]
+            .iter()
+            .zip(&members.weights[..n])
+            .zip(nb.fluid.of(i))
+            .map(|((g2, w), &j)| g2.sqrt() * w / shares(j as usize))
+            .fold(own.norm() / shares(i), f64::max);
+        self.bounded(lambda, stride)
+    }
+
+    /// `lambda` shortened so that the member that moves farthest per unit λ (`stride`, m per
+    /// m²) moves no farther than [`NEWTON_STEP_LIMIT`]·H.
+    #[inline(always)]
+    fn bounded(&self, lambda: f64, stride: f64) -> f64 {
+        let largest = stride * lambda.abs();
         let limit = NEWTON_STEP_LIMIT * self.kernel.support_radius();
         if largest > limit {
             lambda * (limit / largest)
@@ -288,9 +329,11 @@ impl DensityConstraint {
             }
             let mut lambda = -c / (denominator + REGULARIZATION);
             let w_i = self.weight_of(nb, i);
-            if materialized {
-                lambda = self.bounded_newton_step(lambda, grad_i * w_i, &scratch.grads, w);
-            }
+            lambda = if materialized {
+                self.bounded_newton_step(lambda, grad_i * w_i, &scratch.grads, w)
+            } else {
+                self.bounded_first_step(lambda, grad_i * w_i, &scratch.members, i, nb)
+            };
             out.self_correction += grad_i * (lambda * w_i);
             total_lambda += lambda;
             if step == 0 && !self.evaluate_first_step && !self.materialize_all {

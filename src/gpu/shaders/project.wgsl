@@ -74,6 +74,14 @@ struct Gradients {
     denominator: f32,
     // max_j |∇_{p_j} C_i|·w_j over the neighbours (1/m).
     largest: f32,
+    // max_j |∇_{p_j} C_i|·w_j/(n_j + 1) over the neighbours (1/m): the share of the move
+    // the global step makes of a correction.
+    largest_share: f32,
+}
+
+// n_j + 1: how many corrections the global step averages for particle j.
+fn shares(j: u32) -> f32 {
+    return f32(fluid_offset[j + 1u] - fluid_offset[j] + 1u);
 }
 
 fn gradients(i: u32, pi: vec3<f32>, mode: u32, lambda: f32, seg: u32) -> Gradients {
@@ -86,6 +94,7 @@ fn gradients(i: u32, pi: vec3<f32>, mode: u32, lambda: f32, seg: u32) -> Gradien
     var own = walls / P.rest_density;
     var denominator = 0.0;
     var largest = 0.0;
+    var largest_share = 0.0;
     let first = fluid_offset[i];
     for (var e = first; e < fluid_offset[i + 1u]; e++) {
         let j = fluid_list[e];
@@ -94,8 +103,9 @@ fn gradients(i: u32, pi: vec3<f32>, mode: u32, lambda: f32, seg: u32) -> Gradien
         own += g;
         denominator += dot(g, g);
         largest = max(largest, length(g) * weight_of(j));
+        largest_share = max(largest_share, length(g) * weight_of(j) / shares(j));
     }
-    return Gradients(own, denominator + dot(own, own), largest);
+    return Gradients(own, denominator + dot(own, own), largest, largest_share);
 }
 
 @compute @workgroup_size(256)
@@ -153,12 +163,16 @@ fn project(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: 
             break;
         }
         var lambda = -c / (g.denominator + REGULARIZATION);
+        // Steps after the first move no member farther than H/4, and the first step's share
+        // of the global step's move none farther either (docs/method.md §2.5).
+        var largest = max(length(g.own) * w_i / shares(i), g.largest_share) * abs(lambda);
         if materialized {
-            // Steps after the first move no member farther than H/4 (docs/method.md §2.5).
-            let largest = max(length(g.own) * w_i, g.largest) * abs(lambda);
-            if largest > P.newton_limit {
-                lambda *= P.newton_limit / largest;
-            }
+            largest = max(length(g.own) * w_i, g.largest) * abs(lambda);
+        }
+        if largest > P.newton_limit {
+            lambda *= P.newton_limit / largest;
+        }
+        if materialized {
             let scale = P.mass / P.rest_density;
             // The members' gradients at p before this step's move of p_i.
             for (var e = first; e < first + members; e++) {

@@ -222,7 +222,7 @@ typedef struct PfParams {
      */
     double mass_factor;
     /**
-     * Constraint stiffness k (N/m). Default 5e4.
+     * Constraint stiffness k (N/m). Default 1e6.
      */
     double stiffness;
     /**

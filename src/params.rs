@@ -364,7 +364,7 @@ impl Params {
             particle_radius: r,
             rest_density: 1000.0,
             mass_factor: rest_mass_factor(),
-            stiffness: 5e4,
+            stiffness: 1e6,
             gravity: [0.0, -9.81, 0.0],
             solver: SolverKind::Chebyshev,
             chebyshev: ChebyshevParams::default(),

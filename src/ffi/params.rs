@@ -83,7 +83,7 @@ pub struct PfParams {
     /// Particle mass as a fraction of ρ0·(2r)³ (dimensionless). Default ≈ 1.0000275, at which
     /// a cubic lattice of spacing 2r starts at ρ0; 0.8 is the convention of other SPH codes.
     pub mass_factor: f64,
-    /// Constraint stiffness k (N/m). Default 5e4.
+    /// Constraint stiffness k (N/m). Default 1e6.
     pub stiffness: f64,
     /// Gravitational acceleration (m/s²). Default (0, −9.81, 0).
     pub gravity: [f64; 3],

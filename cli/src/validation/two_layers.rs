@@ -46,7 +46,7 @@ pub struct Setup {
 impl Default for Setup {
     fn default() -> Self {
         Self {
-            across: 10,
+            across: 12,
             particle_radius: 0.025,
             light_density: 800.0,
             relax: 2.0,

@@ -205,7 +205,7 @@ pub(crate) struct PoiseuilleArgs {
 #[derive(Args)]
 pub(crate) struct TwoLayersArgs {
     /// Particles across the tank at rest (6–40; see docs/validation.md for both tanks).
-    #[arg(long, value_name = "N", default_value_t = 10)]
+    #[arg(long, value_name = "N", default_value_t = 12)]
     resolution: usize,
     /// Rest density of the lighter liquid, in kg/m³ (the other is water, 1000).
     #[arg(

@@ -12,9 +12,9 @@
 //! The step's iteration rarely ends at that fixed point, so k·λ_i is taken from the
 //! multipliers the last step carried through its iteration (docs/method.md §10.1): what its
 //! constraints did over the whole step, wherever the iteration stopped. Where the last step
-//! did not carry them (the warm start, the coarse correction) or particles
-//! were added or moved since, λ_i is the multiplier of a local step at the current positions,
-//! which needs a tight outer tolerance to be accurate.
+//! did not carry them (the warm start, the coarse correction) or particles were added or
+//! moved since, λ_i is the multiplier of a local step at the current positions, which needs a
+//! tight outer tolerance to be accurate.
 
 use crate::constraint::{Corrections, Neighborhood, Projection};
 use crate::world::Snapshot;

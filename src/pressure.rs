@@ -17,9 +17,9 @@
 //! tight outer tolerance to be accurate.
 
 use crate::constraint::{Corrections, Neighborhood, Projection};
+use crate::reduce::sum_over;
 use crate::world::Snapshot;
 use crate::{Vec3, World};
-use rayon::prelude::*;
 
 /// Pressures estimated from the constraint forces at the current positions.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -79,15 +79,10 @@ impl World {
     fn mean_vertical_force(&self, x: &[Vec3], nb: &Neighborhood, pressures: &[f64]) -> f64 {
         let c = &self.constraint;
         let volume = c.mass / c.rest_density;
-        let force_sum: f64 = (0..x.len())
-            .into_par_iter()
-            .map_init(Vec::new, |grads, i| {
-                let k_lambda = -pressures[i] * volume / c.membership(nb.fluid, i);
-                k_lambda * c.weighted_gradient_sum(i, x, nb, grads).y
-            })
-            .collect::<Vec<f64>>()
-            .iter()
-            .sum();
+        let force_sum = sum_over(x.len(), |i| {
+            let k_lambda = -pressures[i] * volume / c.membership(nb.fluid, i);
+            k_lambda * c.weighted_gradient_sum(i, x, nb).y
+        });
         force_sum / x.len().max(1) as f64
     }
 

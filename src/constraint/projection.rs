@@ -132,22 +132,35 @@ impl DensityConstraint {
 
     /// Σ_j w_j ∇_{x_j} C_i (1/m) over the fluid members j of constraint i's stencil, i
     /// included, at positions `x`: multiplied by k·λ_i (N·m), the force constraint i exerts
-    /// on the fluid (docs/method.md §10.1). `grads` is scratch room.
-    pub(crate) fn weighted_gradient_sum(
-        &self,
-        i: usize,
-        x: &[Vec3],
-        nb: &Neighborhood,
-        grads: &mut Vec<Vec3>,
-    ) -> Vec3 {
-        let members = nb.fluid.of(i);
-        let (grad_i, _) = self.gradients(i, x[i], |s| x[members[s] as usize], nb, grads);
-        grads
+    /// on the fluid (docs/method.md §10.1).
+    pub(crate) fn weighted_gradient_sum(&self, i: usize, x: &[Vec3], nb: &Neighborhood) -> Vec3 {
+        let scale = self.mass / self.rest_density;
+        let pi = x[i];
+        // ∇_{x_i} C_i gathers the boundary's and the walls' share and minus every member's
+        // gradient ∇_{x_j} C_i = −(m/ρ0)∇W(x_i − x_j), as in `gradients`.
+        let (grad_i, members) = nb.fluid.of(i).iter().fold(
+            (self.boundary_gradient(pi, i, nb), Vec3::zeros()),
+            |(grad_i, members), &j| {
+                let g = self.kernel.grad_w(&(pi - x[j as usize])) * scale;
+                (grad_i + g, members - g * self.weight_of(nb, j as usize))
+            },
+        );
+        grad_i * self.weight_of(nb, i) + members
+    }
+
+    /// The boundary's and the walls' share of ∇_{x_i} C_i (1/m) for particle i at `pi`.
+    fn boundary_gradient(&self, pi: Vec3, i: usize, nb: &Neighborhood) -> Vec3 {
+        let kernel = &self.kernel;
+        (nb.boundary
+            .of(i)
             .iter()
-            .zip(members)
-            .fold(grad_i * self.weight_of(nb, i), |sum, (g, &j)| {
-                sum + g * self.weight_of(nb, j as usize)
+            .map(|&b| {
+                let b = b as usize;
+                kernel.grad_w(&(pi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
             })
+            .sum::<Vec3>()
+            + self.walls_at(pi, nb.walls).gradient)
+            / self.rest_density
     }
 
     /// ∇_{p_i} C_i (returned with D = Σ_j |∇_{p_j} C_i|² over the fluid members; boundary
@@ -163,17 +176,7 @@ impl DensityConstraint {
     ) -> (Vec3, f64) {
         let kernel = &self.kernel;
         let scale = self.mass / self.rest_density;
-        let mut grad_i: Vec3 = (nb
-            .boundary
-            .of(i)
-            .iter()
-            .map(|&b| {
-                let b = b as usize;
-                kernel.grad_w(&(pi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
-            })
-            .sum::<Vec3>()
-            + self.walls_at(pi, nb.walls).gradient)
-            / self.rest_density;
+        let mut grad_i = self.boundary_gradient(pi, i, nb);
         let mut denominator = 0.0;
         grads.clear();
         for s in 0..nb.fluid.count(i) {

@@ -11,9 +11,9 @@ use crate::{Backend, Error, Vec3};
 pub struct GpuPositions<'a> {
     /// One `vec4<f32>` per particle (16 bytes): x, y and z in metres from [`origin`], and
     /// in w the particle's pressure in pascals, as [`World::constraint_pressures`] reads it
-    /// after a step (for colouring by pressure). Particles lie in the device's order, which the steps change. Its usages
-    /// are `STORAGE`, `COPY_SRC` and `COPY_DST`: bind it read-only as a storage buffer (in
-    /// a vertex shader, for instance), or copy it.
+    /// after a step (for colouring by pressure). Particles lie in the device's order, which
+    /// the steps change. Its usages are `STORAGE`, `COPY_SRC` and `COPY_DST`: bind it
+    /// read-only as a storage buffer (in a vertex shader, for instance), or copy it.
     ///
     /// [`origin`]: GpuPositions::origin
     pub buffer: &'a wgpu::Buffer,

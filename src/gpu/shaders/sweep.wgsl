@@ -3,7 +3,8 @@
 // src/solver/sweep.rs: X^(k+1) replaces X^(k−1) in place, and |X^(k+1) − X^(k)| goes to
 // values.y for the displacement rule (§4). The iterates' fourth component carries the
 // particle's pressure through the same recurrence (src/step/carry.rs, §10.1): Λ_j scaled by
-// −ρ0·μ_j/(Δt²·c_j), constant within a step, so that the result holds p_j = −k·λ_j·μ_j/V. ω and whether to extrapolate are the schedule's
+// −ρ0·μ_j/(Δt²·c_j), constant within a step, so that the result holds p_j = −k·λ_j·μ_j/V.
+// ω and whether to extrapolate are the schedule's
 // for the iteration k (control.wgsl). Nothing is written once the outer iteration has stopped,
 // nor where the local step found its pool of kept corrections full (project.wgsl): the host
 // then grows the pool and takes the outer iteration again.

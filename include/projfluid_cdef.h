@@ -310,7 +310,8 @@ typedef struct PfParams {
      */
     double dt_max;
     /**
-     * CFL step size of the first step (s). Default 1e-3.
+     * CFL step size of the first step (s), at most the step over which gravity alone moves a
+     * particle r/4 (docs/method.md §8). Default 1e-3.
      */
     double dt_initial;
     /**

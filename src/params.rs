@@ -254,7 +254,8 @@ pub struct Params {
     pub dt_min: f64,
     /// Largest time step (s), in [`dt_min`](Params::dt_min), [`MAX_STEP`]].
     pub dt_max: f64,
-    /// Time step of the first step (s), in (0, [`MAX_STEP`]] (clamped to [dt_min, dt_max]).
+    /// Time step of the first step (s), in (0, [`MAX_STEP`]]: clamped to [dt_min, dt_max], and
+    /// at most the step over which gravity alone moves a particle r/4 (docs/method.md §8).
     pub dt_initial: f64,
     /// XSPH viscosity coefficient c_X (dimensionless, 0 = off).
     pub viscosity: f64,

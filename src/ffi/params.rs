@@ -135,7 +135,8 @@ pub struct PfParams {
     pub dt_min: f64,
     /// Largest CFL step (s). Default 5e-3.
     pub dt_max: f64,
-    /// CFL step size of the first step (s). Default 1e-3.
+    /// CFL step size of the first step (s), at most the step over which gravity alone moves a
+    /// particle r/4 (docs/method.md §8). Default 1e-3.
     pub dt_initial: f64,
     /// XSPH viscosity coefficient in [0, 1] (0 = off). Default 0.01.
     pub viscosity: f64,

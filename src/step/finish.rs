@@ -3,6 +3,7 @@
 //! non-pressure forces, and the step's statistics.
 
 use super::StepBuffers;
+use super::contain::Containment;
 use super::iterate::Outcome;
 use crate::boundary::Boundary;
 use crate::constraint::{DensityConstraint, Neighborhood};
@@ -22,10 +23,12 @@ pub(super) struct Finish<'a> {
     pub viscosities: &'a [f64],
     /// Step size (s).
     pub dt: f64,
+    /// The containers the fluid is kept inside.
+    pub containment: Containment<'a>,
 }
 
-/// Moves the fluid to the iteration's result X^(k) (in `b.current`), with v = (x^{n+1} −
-/// x^n)/Δt, evaluates the densities, applies the non-pressure forces and measures the step.
+/// Moves the fluid to the iteration's result X^(k) (in `b.current`), kept inside its
+/// containers (docs/method.md §7), with v = (x^{n+1} − x^n)/Δt, evaluates the densities, applies the non-pressure forces and measures the step.
 pub(super) fn finish(
     f: Finish,
     fluid: &mut Fluid,
@@ -39,8 +42,10 @@ pub(super) fn finish(
         forces,
         viscosities,
         dt,
+        containment,
     } = f;
     let t = Instant::now();
+    containment.keep_inside(&fluid.positions, &mut b.current);
     fluid
         .velocities
         .par_iter_mut()

@@ -11,6 +11,7 @@
 
 mod carry;
 mod coarse;
+mod contain;
 mod couple;
 mod finish;
 pub(crate) mod iterate;
@@ -236,6 +237,10 @@ pub(crate) fn take_step(ctx: StepContext, dt: f64) -> Result<(StepStats, f64), T
                 forces,
                 viscosities: &materials.viscosities,
                 dt,
+                containment: contain::Containment {
+                    containers,
+                    clearance: contain::WALL_CLEARANCE * params.particle_radius,
+                },
             },
             fluid,
             buffers,
@@ -363,14 +368,30 @@ fn next_step_size(
 }
 
 /// The CFL rule's step for the fastest speed `v_max` (m/s, at least √10⁻⁹ counted):
-/// λ·0.4·2r / v_max clamped to [Δt_min, Δt_max] (s), Δt_min where it is not finite. The CPU
-/// and GPU backends both end their steps with it (docs/method.md §8).
+/// λ·0.4·2r / v_max, at most [`weight_step`], clamped to [Δt_min, Δt_max] (s), Δt_min where
+/// it is not finite. The CPU and GPU backends both end their steps with it
+/// (docs/method.md §8).
 pub(crate) fn cfl_step(params: &Params, v_max: f64) -> f64 {
     let v_max = v_max.max(1e-9f64.sqrt());
-    let cfl = params.cfl_factor * 0.4 * params.spacing() / v_max;
+    let cfl = (cfl_move(params) / v_max).min(weight_step(params));
     if cfl.is_finite() {
         cfl.clamp(params.dt_min, params.dt_max)
     } else {
         params.dt_min
     }
+}
+
+/// The farthest the CFL rule lets a particle move in one step, λ·0.4·2r (m).
+fn cfl_move(params: &Params) -> f64 {
+    params.cfl_factor * 0.4 * params.spacing()
+}
+
+/// The longest step (s) over which gravity alone moves a particle from rest at most a quarter
+/// of the CFL rule's move: |g|·Δt² ≤ λ·0.4·2r/4 (docs/method.md §8); infinite without
+/// gravity. With the default Δt_max it binds only for particles smaller than about a
+/// millimetre, where longer steps let the weight of a column at rest push its bottom layer
+/// into a wall one layer thick faster than the solve lifts it back.
+pub(crate) fn weight_step(params: &Params) -> f64 {
+    let g = Vec3::from(params.gravity).norm();
+    (0.25 * cfl_move(params) / g).sqrt()
 }

@@ -141,7 +141,9 @@ impl World {
             forces: forces::of_world(&params, &Materials::new(params.kinematic_viscosity)),
             buffers: StepBuffers::default(),
             time: 0.0,
-            next_dt: params.dt_initial.clamp(params.dt_min, params.dt_max),
+            next_dt: (params.dt_initial)
+                .min(crate::step::weight_step(&params))
+                .clamp(params.dt_min, params.dt_max),
             steps: 0,
             last: None,
             #[cfg(feature = "gpu")]

@@ -149,7 +149,8 @@ class Params:
     dt_max: float = _C_DEFAULTS.dt_max
     """Largest CFL step (s)."""
     dt_initial: float = _C_DEFAULTS.dt_initial
-    """CFL step size of the first step (s)."""
+    """CFL step size of the first step (s), at most the step over which gravity alone
+    moves a particle r/4 (docs/method.md §8)."""
     viscosity: float = _C_DEFAULTS.viscosity
     """XSPH viscosity coefficient in [0, 1] (0 = off)."""
     threads: int = _C_DEFAULTS.threads

@@ -3,34 +3,10 @@
 //! stays at rest under the CFL rule, and water driven at a floor by steps far longer than the
 //! rule allows, as an engine stepping at its frame rate drives it, stays inside.
 
-use projfluid::boundary::Aabb;
-use projfluid::{Params, Vec3, World};
+#[path = "support/thrown.rs"]
+mod thrown;
 
-/// A closed box of `cells` particle spacings along each axis for particles of radius `r`
-/// (m), with a block of `count` particles 0.25 spacings from its lower walls.
-fn tank(r: f64, cells: f64, count: [usize; 3]) -> World {
-    let mut world = World::new(Params::with_radius(r)).unwrap();
-    let d = 2.0 * r;
-    let container = Aabb {
-        min: Vec3::zeros(),
-        max: Vec3::repeat(cells * d),
-    };
-    world.add_container(container, 1).unwrap();
-    world
-        .add_fluid_block(Vec3::repeat(0.5 * d), count, Vec3::zeros())
-        .unwrap();
-    world
-}
-
-/// The least distance (m) of any fluid particle from the planes of the walls of the box
-/// [0, `side`]³, negative for a particle outside.
-fn clearance(world: &World, side: f64) -> f64 {
-    world
-        .positions()
-        .iter()
-        .map(|p| p.min().min(side - p.max()))
-        .fold(f64::INFINITY, f64::min)
-}
+use thrown::{clearance, tank, thrown_at_the_floor};
 
 /// A block of 10³ particles at rest in a tank, stepped by the CFL rule, stays at rest for 300
 /// steps at r = 0.1 mm, 30 µm and 10 µm: no particle leaves, the root-mean-square speed stays
@@ -61,12 +37,7 @@ fn a_tank_of_tiny_particles_stays_at_rest() {
 /// the first step.
 #[test]
 fn water_stepped_at_a_frame_rate_stays_in_its_container() {
-    let r = 0.025;
-    let side = 24.0 * 2.0 * r;
-    let mut world = tank(r, 24.0, [8, 8, 8]);
-    let block: Vec<Vec3> = world.velocities();
-    let thrown = vec![Vec3::new(1.0, -4.0, 0.5); block.len()];
-    world.set_velocities(&thrown).unwrap();
+    let (mut world, r, side) = thrown_at_the_floor();
     for step in 0..60 {
         world.step_with_dt(1.0 / 60.0).unwrap();
         let least = clearance(&world, side);

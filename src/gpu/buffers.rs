@@ -175,6 +175,8 @@ pub(super) struct Buffers {
     /// Boundary particles sorted by cell (position and ψ (kg) in w) and each cell's first.
     pub boundary: wgpu::Buffer,
     pub boundary_start: wgpu::Buffer,
+    /// The containers' count and clearance, then their corners (m, relative).
+    pub containers: wgpu::Buffer,
     /// Neighbour counts, offsets (n + 1) and lists.
     pub fluid_count: wgpu::Buffer,
     pub boundary_count: wgpu::Buffer,
@@ -212,20 +214,33 @@ pub(super) struct Buffers {
 const VEC4: u64 = 16;
 const WORD: u64 = 4;
 
+/// What stays fixed for a stepper's life, in device form: the boundary sorted by cell
+/// (positions relative to the grid's centre, ψ in w) with each cell's first slot (cells + 1
+/// entries), and the containers' table (`container_table` in stepper.rs).
+#[derive(Clone, Copy)]
+pub(super) struct Statics<'a> {
+    pub boundary: &'a [[f32; 4]],
+    pub boundary_start: &'a [u32],
+    pub containers: &'a [[f32; 4]],
+}
+
 impl Buffers {
-    /// The buffers for `n` fluid particles and the sorted boundary `boundary` (device
-    /// positions, ψ in w) with its cells' first slots `boundary_start`, over `cells` cells,
+    /// The buffers for `n` fluid particles and what stays fixed, `statics`, over `cells` cells,
     /// for outer iterations of at most `iterations` iterations; with room for the
     /// vorticities where `vorticity` (the confinement is on).
     pub fn new(
         ctx: &Context,
         n: u32,
         cells: u32,
-        boundary: &[[f32; 4]],
-        boundary_start: &[u32],
+        statics: &Statics,
         iterations: u64,
         vorticity: bool,
     ) -> Self {
+        let Statics {
+            boundary,
+            boundary_start,
+            containers,
+        } = *statics;
         let particles = u64::from(n);
         let vec4 = |label| ctx.storage(label, particles * VEC4);
         let word = |label, count: u64| ctx.storage(label, count * WORD);
@@ -252,6 +267,7 @@ impl Buffers {
             cell_start: word("cell_start", cell_words),
             boundary: ctx.storage("boundary", boundary.len() as u64 * VEC4),
             boundary_start: word("boundary_start", cell_words),
+            containers: ctx.storage("containers", containers.len() as u64 * VEC4),
             fluid_count: word("fluid_count", particles),
             boundary_count: word("boundary_count", particles),
             fluid_offset: word("fluid_offset", particles + 1),
@@ -280,6 +296,8 @@ impl Buffers {
             0,
             bytemuck::cast_slice(boundary_start),
         );
+        ctx.queue
+            .write_buffer(&buffers.containers, 0, bytemuck::cast_slice(containers));
         buffers
     }
 

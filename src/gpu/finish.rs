@@ -1,9 +1,9 @@
 //! The end of a step on the device (docs/method.md §1.3 steps 5–8; shaders/finish.wgsl):
-//! velocities from the positions, the new positions, the densities at them, then (after the
-//! physical viscosity where a material has one, viscosity.rs) the vorticity confinement
-//! where it is on (§15, shaders/vorticity.wgsl), the XSPH filter, and the
-//! per-particle values of the step's density errors and of the CFL rule, reduced after
-//! (reduce.rs). The CFL rule itself is [`next_step_size`].
+//! the new positions, kept inside their containers (§7), velocities from the positions, the
+//! densities at them, then (after the physical viscosity where a material has one,
+//! viscosity.rs) the vorticity confinement where it is on (§15, shaders/vorticity.wgsl), the
+//! XSPH filter, and the per-particle values of the step's density errors and of the CFL
+//! rule, reduced after (reduce.rs). The CFL rule itself is [`next_step_size`].
 
 use super::buffers::Buffers;
 use super::context::{Context, Kernel, Slot, dispatch};
@@ -28,7 +28,7 @@ impl Finish {
     /// The finishing kernels, with the vorticity confinement's where `confine` (its ε > 0).
     pub fn new(ctx: &Context, confine: bool) -> Self {
         let mut slots = vec![Slot::Uniform, Slot::Uniform];
-        slots.extend([Slot::Storage; 11]);
+        slots.extend([Slot::Storage; 12]);
         let kernel = ctx.kernel(
             "finish",
             with_common!("shaders/finish.wgsl"),
@@ -77,6 +77,7 @@ impl Finish {
                         &b.boundary_list,
                         &b.boundary,
                         &b.values,
+                        &b.containers,
                     ],
                 )
             })

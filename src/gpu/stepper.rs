@@ -13,7 +13,7 @@
 //! Left out for now, as CPU-only extras that are off by default: the warm start (§4.1) and
 //! the coarse correction (§3.8); a GPU step always starts from s.
 
-use super::buffers::{Buffers, Grid, IterParams, MATERIAL_SLOTS, StepParams};
+use super::buffers::{Buffers, Grid, IterParams, MATERIAL_SLOTS, Statics, StepParams};
 use super::context::{Context, Kernel, floats, words};
 use super::control::{BATCH, Control, Stop};
 use super::finish::{Finish, next_step_size};
@@ -41,6 +41,8 @@ pub(crate) struct Scene<'a> {
     pub boundary: &'a [Vec3],
     pub psi: &'a [f64],
     pub params: &'a Params,
+    /// The containers the fluid is kept inside (m; docs/method.md §7).
+    pub containers: &'a [Aabb],
     /// Every fluid particle's material, in the order of `positions`.
     pub materials: &'a [MaterialId],
     /// Every material's mass ratio m_k/m = ρ0_k/ρ0 (dimensionless), by id.
@@ -167,6 +169,8 @@ impl GpuStepper {
             });
         let grid = Grid::covering(bounds, h);
         let (boundary, boundary_start) = sort_boundary(&grid, scene.boundary, scene.psi);
+        let clearance = crate::step::WALL_CLEARANCE * params.particle_radius;
+        let containers = container_table(&grid, scene.containers, clearance);
         let confine = params.vorticity_confinement > 0.0;
         let cells = grid.cells();
         let iterations = params.max_outer_iterations as u64;
@@ -174,8 +178,11 @@ impl GpuStepper {
             &ctx,
             n,
             cells,
-            &boundary,
-            &boundary_start,
+            &Statics {
+                boundary: &boundary,
+                boundary_start: &boundary_start,
+                containers: &containers,
+            },
             iterations,
             confine,
         );
@@ -686,6 +693,18 @@ fn constants(params: &Params, grid: &Grid, scene: Scene, boundary_n: u32) -> Ste
         vorticity: params.vorticity_confinement as f32,
         inverse_ratio,
     }
+}
+
+/// The containers in device form (`containers` in shaders/finish.wgsl): a header of their
+/// count and the clearance (m), then each container's lowest and highest corner relative to
+/// the grid's centre (m).
+fn container_table(grid: &Grid, containers: &[Aabb], clearance: f64) -> Vec<[f32; 4]> {
+    let mut table = vec![[containers.len() as f32, clearance as f32, 0.0, 0.0]];
+    for c in containers {
+        table.push(grid.device_position(c.min));
+        table.push(grid.device_position(c.max));
+    }
+    table
 }
 
 /// The boundary particles at `points` (m) with masses `psi` (kg) in device form, sorted by

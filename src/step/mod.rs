@@ -19,6 +19,7 @@ mod search;
 mod undo;
 mod warm_start;
 
+pub(crate) use contain::WALL_CLEARANCE;
 pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
 pub(crate) use undo::Undo;

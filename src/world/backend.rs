@@ -193,6 +193,7 @@ impl World {
                 materials: &self.fluid.materials,
                 mass_ratios: &self.materials.mass_ratios,
                 params: &self.params,
+                containers: &self.containers,
                 mass: self.constraint.mass,
                 membership_floor: self.constraint.membership_floor,
                 device: device.as_ref(),

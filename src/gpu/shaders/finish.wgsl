@@ -1,9 +1,9 @@
-// The end of a step (docs/method.md §1.3 steps 5–8): v = (x^{n+1} − x^n)/Δt and the new
-// positions, the densities at them (unless the last local step evaluated them there), the
-// XSPH filter (Monaghan 1989) into `velocity_out`, and per particle the values the step's
-// statistics and the CFL rule reduce: max(ρ_i/ρ0 − 1, 0) in x and y, |v_i + Δt·g|² in z.
-// The vorticity confinement (vorticity.wgsl), where it is on, runs between `update` and
-// `xsph`.
+// The end of a step (docs/method.md §1.3 steps 5–8): the new positions, kept inside their
+// containers (§7), v = (x^{n+1} − x^n)/Δt, the densities at the new positions (unless the
+// last local step evaluated them there), the XSPH filter (Monaghan 1989) into
+// `velocity_out`, and per particle the values the step's statistics and the CFL rule reduce:
+// max(ρ_i/ρ0 − 1, 0) in x and y, |v_i + Δt·g|² in z. The vorticity confinement
+// (vorticity.wgsl), where it is on, runs between `update` and `xsph`.
 
 struct IterParams {
     gamma: f32,
@@ -25,6 +25,23 @@ struct IterParams {
 @group(0) @binding(10) var<storage, read_write> boundary_list: array<u32>;
 @group(0) @binding(11) var<storage, read_write> boundary: array<vec4<f32>>;
 @group(0) @binding(12) var<storage, read_write> values: array<vec4<f32>>;
+// The containers' count and clearance (m), then each one's lowest and highest corner (m).
+@group(0) @binding(13) var<storage, read_write> containers: array<vec4<f32>>;
+
+// `p` kept at least the clearance inside the walls of the first container that holds `start`
+// (docs/method.md §7); unchanged where none does.
+fn contained(start: vec3<f32>, p: vec3<f32>) -> vec3<f32> {
+    let count = u32(containers[0].x);
+    let clearance = containers[0].y;
+    for (var c = 0u; c < count; c++) {
+        let low = containers[1u + 2u * c].xyz;
+        let high = containers[2u + 2u * c].xyz;
+        if all(start >= low) && all(start <= high) {
+            return min(max(p, low + clearance), high - clearance);
+        }
+    }
+    return p;
+}
 
 @compute @workgroup_size(256)
 fn update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: vec3<u32>,
@@ -33,7 +50,7 @@ fn update(@builtin(workgroup_id) wid: vec3<u32>, @builtin(num_workgroups) nwg: v
     if i >= P.n {
         return;
     }
-    let p = result[i].xyz;
+    let p = contained(x[i].xyz, result[i].xyz);
     velocity[i] = vec4<f32>((p - x[i].xyz) / P.gravity.w, 0.0);
     // The pressure the iteration carried (sweep.wgsl) rides along in x's fourth component.
     x[i] = vec4<f32>(p, result[i].w);

@@ -327,7 +327,7 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 17] = [
+    let cases: [&[&str]; 18] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
         &[
             "validate",
@@ -433,6 +433,14 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
             "two-layers",
             "--resolution",
             "3",
+            "--out",
+            out_dir,
+        ],
+        &[
+            "validate",
+            "martin-moyce",
+            "--coarse-correction",
+            "maybe",
             "--out",
             out_dir,
         ],

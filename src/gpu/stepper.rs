@@ -169,7 +169,7 @@ impl GpuStepper {
             });
         let grid = Grid::covering(bounds, h);
         let (boundary, boundary_start) = sort_boundary(&grid, scene.boundary, scene.psi);
-        let clearance = crate::step::WALL_CLEARANCE * params.particle_radius;
+        let clearance = crate::step::contain::WALL_CLEARANCE * params.particle_radius;
         let containers = container_table(&grid, scene.containers, clearance);
         let confine = params.vorticity_confinement > 0.0;
         let cells = grid.cells();

@@ -11,7 +11,7 @@
 
 mod carry;
 mod coarse;
-mod contain;
+pub(crate) mod contain;
 mod couple;
 mod finish;
 pub(crate) mod iterate;
@@ -19,7 +19,6 @@ mod search;
 mod undo;
 mod warm_start;
 
-pub(crate) use contain::WALL_CLEARANCE;
 pub(crate) use couple::{Coupling, Load};
 pub(crate) use search::SearchGrid;
 pub(crate) use undo::Undo;

@@ -8,7 +8,8 @@
 //! projfluid run --resume FILE [--steps N | --duration SECONDS] [output options]
 //! projfluid scenes
 //! projfluid validate martin-moyce [--n2 2|1] [--resolution N] [--layers N] [--duration TAU]
-//!                                 [--solver S] [--threads N] [--out DIR]
+//!                                 [--coarse-correction on|off] [--solver S] [--threads N]
+//!                                 [--out DIR]
 //! projfluid validate hydrostatic [--count NX,NY,NZ] [--relax SECONDS] [--damping RATE]
 //!                                [--settle SECONDS] [--settings calm|default] [--tau METRES]
 //!                                [--reading-tau METRES] [--solver S] [--threads N] [--out DIR]

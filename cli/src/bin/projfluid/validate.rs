@@ -3,7 +3,7 @@
 //! hydrostatics, viscous flow down a duct against its analytic profile, and two liquids at
 //! rest and overturning. Prints a table and writes CSV and PNG files.
 
-use crate::{Failure, solver_parser};
+use crate::{Failure, on_off_parser, solver_parser};
 use clap::{Args, Subcommand};
 use projfluid::scene::ContainerWalls;
 use projfluid::{Error, SolverKind};
@@ -75,6 +75,10 @@ pub(crate) struct MartinMoyceArgs {
     /// Dimensionless duration tau = t·√(g/a) [default: 3.0 for n² = 2, 3.5 for n² = 1].
     #[arg(long, value_name = "TAU", allow_negative_numbers = true)]
     duration: Option<f64>,
+    /// Start every step's outer iteration from the coarse correction (off by default, as in
+    /// `projfluid run`).
+    #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
+    coarse_correction: Option<bool>,
     #[command(flatten)]
     common: CommonArgs,
 }
@@ -270,6 +274,7 @@ fn martin_moyce(args: &MartinMoyceArgs) -> Result<(), Failure> {
     setup.solver = args.common.solver;
     setup.threads = args.common.threads;
     setup.walls = args.common.walls();
+    setup.coarse_correction = args.coarse_correction.unwrap_or(false);
     if let Some(d) = args.duration {
         setup.duration = d;
     }

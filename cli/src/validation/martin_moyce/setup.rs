@@ -23,6 +23,9 @@ pub struct Setup {
     pub threads: usize,
     /// What the tank's walls are (default: particles, as in scenes).
     pub walls: ContainerWalls,
+    /// Whether the outer iteration starts from the coarse correction (docs/method.md §3.8;
+    /// off, as by default).
+    pub coarse_correction: bool,
 }
 
 impl Setup {
@@ -37,6 +40,7 @@ impl Setup {
             solver: SolverKind::Chebyshev,
             threads: 0,
             walls: ContainerWalls::Particles,
+            coarse_correction: false,
         }
     }
 
@@ -95,6 +99,7 @@ impl Setup {
         let params = Params {
             solver: self.solver,
             threads: self.threads,
+            coarse_correction: self.coarse_correction,
             ..Params::with_radius(0.5 * d)
         };
         let r = params.particle_radius;
@@ -139,6 +144,12 @@ mod tests {
         // Centres start one spacing plus r/4 from the walls: extents a + r/4 and 2a + r/4.
         assert!((z - (a + 0.125 * d)).abs() < 1e-9, "z = {z}");
         assert!((h - (2.0 * a + 0.125 * d)).abs() < 1e-9, "h = {h}");
+        assert!(!world.params().coarse_correction);
+        let corrected = Setup {
+            coarse_correction: true,
+            ..s.clone()
+        };
+        assert!(corrected.build().unwrap().0.params().coarse_correction);
         for bad in [
             Setup {
                 n2: 3,

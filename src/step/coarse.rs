@@ -6,6 +6,8 @@
 //! ∇²φ = −e, e being the fluid's excess volume per cell, with φ = 0 at the free surface and
 //! no flux into solids. This is the smallest irrotational displacement that removes the
 //! compression the lattice sees; the fine iteration then resolves what is finer than a cell.
+//! Each particle moves by u interpolated within its own cell between the gradients across
+//! the cell's faces, so that the move's divergence is the one the equation solved for.
 
 mod poisson;
 
@@ -132,25 +134,6 @@ impl Lattice {
             (self.first[a] as f64 + k[a] as f64 + 0.5) * self.edge
         }))
     }
-
-    /// The eight cell centres around `x` and their trilinear weights.
-    fn corners(&self, x: &Vec3) -> [(usize, f64); 8] {
-        let mut base = [0usize; 3];
-        let mut t = [0.0; 3];
-        for a in 0..3 {
-            let f = x[a] / self.edge - self.first[a] as f64 - 0.5;
-            let floor = f.floor().clamp(0.0, self.dims[a] as f64 - 2.0);
-            base[a] = floor as usize;
-            t[a] = (f - floor).clamp(0.0, 1.0);
-        }
-        std::array::from_fn(|k| {
-            let d = [k & 1, (k >> 1) & 1, (k >> 2) & 1];
-            let w = (0..3)
-                .map(|a| if d[a] == 1 { t[a] } else { 1.0 - t[a] })
-                .product();
-            (self.index([0, 1, 2].map(|a| base[a] + d[a])), w)
-        })
-    }
 }
 
 /// The box around the fluid particles of a cell (m).
@@ -201,7 +184,7 @@ pub(crate) struct CoarseCorrection {
     fill: Vec<f64>,
     /// The box around each cell's fluid particles.
     extent: Vec<Extent>,
-    /// The faces of each fluid cell that a solid inside it closes ([`Layout::closed`]).
+    /// The faces of each fluid cell that a solid closes ([`Layout::closed`]).
     closed: Vec<u8>,
     /// The right-hand side: excess volume over the cell edge (m²).
     excess: Vec<f64>,
@@ -213,11 +196,6 @@ pub(crate) struct CoarseCorrection {
     last_lattice: Option<Lattice>,
     /// Each fluid slot's cell.
     slot_cell: Vec<u32>,
-    /// −∇φ at every cell centre, extrapolated into the cells around the fluid (m).
-    field: Vec<Vec3>,
-    known: Vec<bool>,
-    /// The field and whether it is set, one extension further out.
-    next_field: Vec<(Vec3, bool)>,
     poisson: Poisson,
 }
 
@@ -268,9 +246,6 @@ impl CoarseCorrection {
         let cells = lattice.len();
         reserve_total(&mut self.slot_cell, n)?;
         reserve_total(&mut self.cells, cells)?;
-        reserve_total(&mut self.known, cells)?;
-        reserve_total(&mut self.field, cells)?;
-        reserve_total(&mut self.next_field, cells)?;
         reserve_total(&mut self.extent, cells)?;
         reserve_total(&mut self.closed, cells)?;
         for v in [
@@ -297,14 +272,19 @@ impl CoarseCorrection {
             self.last_phi.clone_from(&self.phi);
             self.last_lattice = Some(lattice);
         }
-        self.displacement_field(&lattice);
-        let field = &self.field;
-        let reach = fluid.reach;
+        let layout = Layout {
+            cells: &self.cells,
+            theta: &self.theta,
+            closed: &self.closed,
+            strides: lattice.strides(),
+        };
+        let (phi, reach) = (&self.phi, fluid.reach);
         current
             .par_iter_mut()
             .zip(previous.par_iter_mut())
-            .for_each(|(x, previous)| {
-                let u: Vec3 = lattice.corners(x).iter().map(|&(c, w)| field[c] * w).sum();
+            .zip(self.slot_cell.par_iter())
+            .for_each(|((x, previous), &c)| {
+                let u = displacement(&layout, &lattice, phi, c as usize, x);
                 let length = u.norm();
                 let u = if length > reach {
                     u * (reach / length)
@@ -359,7 +339,7 @@ impl CoarseCorrection {
                 continue;
             };
             match self.cells[c] {
-                Cell::Air => self.cells[c] = Cell::Solid,
+                Cell::Air => self.close_faces_towards(lattice, c, &b),
                 Cell::Fluid => self.closed[c] |= self.extent[c].faces_beyond(&b),
                 Cell::Solid => {}
             }
@@ -392,6 +372,28 @@ impl CoarseCorrection {
         true
     }
 
+    /// Closes the faces towards cell `c` (without fluid) of the fluid cells beside it whose
+    /// fluid a boundary particle at `b` (m) in `c` lies in front of: within the fluid's
+    /// extent along the face's two axes, as a wall across the face is. A wall that runs past
+    /// the fluid, such as a side wall above the water, leaves the face open: the water's
+    /// surface below it stays free.
+    fn close_faces_towards(&mut self, lattice: &Lattice, c: usize, b: &Vec3) {
+        let (k, strides) = (lattice.coordinates(c), lattice.strides());
+        for a in 0..3 {
+            let (e, f) = ((a + 1) % 3, (a + 2) % 3);
+            // The neighbour below c along a sees c across its face towards +a, and so on.
+            let below = (k[a] > 0).then(|| (c - strides[a], 2 * a + 1));
+            let above = (k[a] + 1 < lattice.dims[a]).then(|| (c + strides[a], 2 * a));
+            for (nb, face) in below.into_iter().chain(above) {
+                let extent = &self.extent[nb];
+                let within = |i: usize| b[i] >= extent.min[i] && b[i] <= extent.max[i];
+                if self.cells[nb] == Cell::Fluid && within(e) && within(f) {
+                    self.closed[nb] |= 1 << face;
+                }
+            }
+        }
+    }
+
     /// Starts φ from the last solve's where the lattices share fluid cells, from 0 elsewhere.
     fn start_from_last(&mut self, lattice: &Lattice) {
         self.phi.clear();
@@ -416,71 +418,32 @@ impl CoarseCorrection {
             *phi = last_phi[last.index(old)];
         });
     }
+}
 
-    /// −∇φ at the fluid cells' centres (one-sided beside a solid, to the free surface at θ
-    /// beside air), then extended twice to the face neighbours of the cells that have it, so
-    /// that particles near the surface and the walls move with the fluid next to them.
-    fn displacement_field(&mut self, lattice: &Lattice) {
-        let layout = Layout {
-            cells: &self.cells,
-            theta: &self.theta,
-            closed: &self.closed,
-            strides: lattice.strides(),
+/// The displacement u = −∇φ (m) of a particle at `x` (m) in fluid cell `c`: each component
+/// interpolated linearly, along its own axis, between the potential's gradients across the
+/// cell's two faces along it, so that u's divergence over the cell is the one the Poisson
+/// equation solved for. Across a face that a solid closes, u takes the other face's value
+/// (a layer on the floor moves with the column above it); between two closed faces, zero.
+fn displacement(layout: &Layout, lattice: &Lattice, phi: &[f64], c: usize, x: &Vec3) -> Vec3 {
+    let edge = lattice.edge;
+    let low = lattice.centre(c) - Vec3::repeat(0.5 * edge);
+    // −∂φ/∂x_a across the face towards +a (`up`) or −a, none across a closed face.
+    let across = |a: usize, up: bool| {
+        let towards = match layout.neighbour(c, a, up) {
+            (nb, Cell::Fluid) => (phi[nb] - phi[c]) / edge,
+            (_, Cell::Air) => -phi[c] / (layout.theta[c] * edge),
+            (_, Cell::Solid) => return None,
         };
-        let (cells, phi, theta) = (&self.cells, &self.phi, &self.theta);
-        let strides = lattice.strides();
-        let edge = lattice.edge;
-        self.field.clear();
-        self.field
-            .par_extend((0..cells.len()).into_par_iter().map(|c| {
-                if cells[c] != Cell::Fluid {
-                    return Vec3::zeros();
-                }
-                // The gradient of φ towards a face neighbour, or none across a solid face.
-                let towards = |a: usize, up: bool| match layout.neighbour(c, a, up) {
-                    (nb, Cell::Fluid) => Some((phi[nb] - phi[c]) / edge),
-                    (_, Cell::Air) => Some(-phi[c] / (theta[c] * edge)),
-                    (_, Cell::Solid) => None,
-                };
-                Vec3::from(std::array::from_fn(
-                    |a| -match (towards(a, false), towards(a, true)) {
-                        (Some(down), Some(up)) => 0.5 * (up - down),
-                        (None, Some(up)) => up,
-                        (Some(down), None) => -down,
-                        (None, None) => 0.0,
-                    },
-                ))
-            }));
-        self.known.clear();
-        self.known
-            .extend(cells.iter().map(|&cell| cell == Cell::Fluid));
-        for _ in 0..2 {
-            let (field, known) = (&self.field, &self.known);
-            self.next_field.clear();
-            self.next_field
-                .par_extend((0..cells.len()).into_par_iter().map(|c| {
-                    if known[c] {
-                        return (field[c], true);
-                    }
-                    let (mut sum, mut count) = (Vec3::zeros(), 0);
-                    for s in strides {
-                        for nb in [c.checked_sub(s), c.checked_add(s)].into_iter().flatten() {
-                            if nb < cells.len() && known[nb] {
-                                sum += field[nb];
-                                count += 1;
-                            }
-                        }
-                    }
-                    if count > 0 {
-                        (sum / count as f64, true)
-                    } else {
-                        (Vec3::zeros(), false)
-                    }
-                }));
-            for (c, &(u, k)) in self.next_field.iter().enumerate() {
-                self.field[c] = u;
-                self.known[c] = k;
-            }
+        Some(if up { -towards } else { towards })
+    };
+    Vec3::from(std::array::from_fn(|a| {
+        let t = ((x[a] - low[a]) / edge).clamp(0.0, 1.0);
+        match (across(a, false), across(a, true)) {
+            (Some(down), Some(up)) => (1.0 - t) * down + t * up,
+            (None, Some(up)) => up,
+            (Some(down), None) => down,
+            (None, None) => 0.0,
         }
-    }
+    }))
 }

@@ -15,7 +15,9 @@ pub(super) enum Cell {
     Air,
     /// Fluid particles: one unknown.
     Fluid,
-    /// A solid without fluid: no flux through the faces it shares with fluid cells.
+    /// Outside a container whose walls are fields: no flux through the faces it shares
+    /// with fluid cells. (Walls of particles close the faces in front of the fluid instead,
+    /// [`Layout::closed`].)
     Solid,
 }
 
@@ -48,8 +50,9 @@ pub(super) struct Layout<'a> {
     /// For each fluid cell, the distance from its centre to the free surface where it
     /// borders air, in cell edges.
     pub theta: &'a [f64],
-    /// For each fluid cell, the faces a solid inside the cell closes (bit 2a for the face
-    /// towards −a, 2a + 1 towards +a), whatever the cell beyond them holds.
+    /// For each fluid cell, the faces a solid closes (bit 2a for the face towards −a, 2a + 1
+    /// towards +a), whatever the cell beyond them holds: boundary particles beyond its fluid,
+    /// in the cell or in the one across the face, within the fluid's extent along the face.
     pub closed: &'a [u8],
     /// Index steps to the neighbour along x, y and z (the lattice has a margin of one
     /// non-fluid cell on every side, so a fluid cell's six neighbours exist).

@@ -124,6 +124,10 @@ pub(crate) struct KleefsmanArgs {
     /// Outer stopping threshold τ in metres [default: 3e-3·r].
     #[arg(long, value_name = "METRES", allow_negative_numbers = true)]
     tau: Option<f64>,
+    /// Start every step's outer iteration from the coarse correction (off by default, as in
+    /// `projfluid run`).
+    #[arg(long, value_name = "on|off", value_parser = on_off_parser())]
+    coarse_correction: Option<bool>,
     #[command(flatten)]
     common: CommonArgs,
 }
@@ -344,6 +348,7 @@ fn kleefsman(args: &KleefsmanArgs) -> Result<(), Failure> {
         solver: args.common.solver,
         threads: args.common.threads,
         walls: args.common.walls(),
+        coarse_correction: args.coarse_correction.unwrap_or(false),
     };
     setup.validate().map_err(option_error)?;
     let data = kleefsman::Measurements::load().map_err(runtime)?;

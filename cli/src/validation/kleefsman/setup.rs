@@ -40,6 +40,9 @@ pub struct Setup {
     pub threads: usize,
     /// What the tank's walls are (default: particles, as in scenes).
     pub walls: ContainerWalls,
+    /// Whether the outer iteration starts from the coarse correction (docs/method.md §3.8;
+    /// off, as by default).
+    pub coarse_correction: bool,
 }
 
 impl Default for Setup {
@@ -57,6 +60,7 @@ impl Default for Setup {
             solver: defaults.solver,
             threads: 0,
             walls: ContainerWalls::Particles,
+            coarse_correction: defaults.coarse_correction,
         }
     }
 }
@@ -136,6 +140,7 @@ impl Setup {
             displacement_tolerance: self.tolerance.unwrap_or(defaults.displacement_tolerance),
             solver: self.solver,
             threads: self.threads,
+            coarse_correction: self.coarse_correction,
             ..defaults
         };
         let wall = tidy(1.25 * r);
@@ -239,6 +244,12 @@ mod tests {
         assert_eq!(setup.fluid_count(), [49, 22, 40]);
         let scene = setup.scene();
         scene.validate().unwrap();
+        assert!(!scene.params.coarse_correction);
+        let corrected = Setup {
+            coarse_correction: true,
+            ..Setup::default()
+        };
+        assert!(corrected.scene().params.coarse_correction);
         let block = &scene.fluid_blocks[0];
         // World frame: x along, y up (22 particles over the depth), z across (40).
         assert_eq!(block.count, [49, 22, 40]);

@@ -61,6 +61,7 @@ pub(super) fn builtin(name: &str) -> Option<Scene> {
                 name: "oil".into(),
                 rest_density: 800.0,
                 kinematic_viscosity: None,
+                surface_tension: None,
             });
             scene.fluid_blocks.push(FluidBlock {
                 material: Some("oil".into()),

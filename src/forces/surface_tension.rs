@@ -1,35 +1,31 @@
-//! Surface tension and adhesion to walls (docs/method.md §16): a cohesion energy that only
-//! the fluid's surface can lower, and an adhesion energy of the fluid against the walls,
-//! each calibrated so that its coefficient is an energy per unit area.
+//! Surface tension and adhesion to walls (docs/method.md §16).
 //!
-//! The cohesion energy of material i's particles is −s_i·ρ_i/ρ0 (J) each, ρ_i/ρ0 = V·Σ_j W_ij
-//! the particle's filled volume fraction (the density constraint's own sum, V = m/ρ0):
+//! Surface tension is the continuum surface force of Brackbill, Kothe and Zemach (1992) in
+//! its SPH form (Morris 2000; Adami, Hu and Adams 2010): the pressure jump σκ across a
+//! surface of curvature κ, spread over the kernel's width as the volume force
 //!
 //! ```text
-//! E = −Σ_i s_i V Σ_j W_ij,     F_i = −∂E/∂x_i = Σ_j 2 s_ij V ∇W(x_i − x_j)      (N)
+//! f = σ κ ∇c / Γ,     c_i = Σ_j V W_ij + Σ_b (ψ_b/ρ0) W_ib,     κ = ∇·n̂,  n̂ = −∇c/|∇c|
 //! ```
 //!
-//! a pair attraction along the kernel's gradient (the pair form of Akinci, Akinci and
-//! Teschner 2013's cohesion, with the kernel as its spline). Inside the fluid the density
-//! constraint holds every ρ_i at ρ0, so no rearrangement of the interior changes E: only the
-//! surface, whose particles miss neighbours, has energy, and the fluid's packing has no
-//! preferred direction to slide into. Splitting the rest lattice along a plane lowers
-//! Σ ρ_i/ρ0 by 2Λ per unit area ([`lattice_pair_sum`]) and makes two surfaces, so
-//! s = σ/Λ gives the surface tension σ (N/m) as the energy per unit area of new surface. Two
-//! materials pair with the geometric mean s_ij = √(s_i s_j) (Berthelot's rule for the
-//! attraction of unlike molecules, which Girifalco and Good carry to interfacial energies).
+//! c being the colour of the fluid (1 inside, falling to 0 across the surface; the walls
+//! count as fluid, so only the free surface pulls). Without particles beyond the surface the
+//! particles' gradients sum to a share Γ ≈ ½ of the colour's unit step: Γ is computed from
+//! the rest lattice when the world is made ([`captured_step`]), and dividing by it makes the
+//! force over the surface the whole σκ per unit area. Each particle has its material's σ;
+//! the force acts at free surfaces, not between two liquids. The force is not a pair force,
+//! so momentum is conserved only as the surface is closed (a drop does not drift).
 //!
-//! The walls' boundary particles enter each density as ψ_b W_ib/ρ0; the adhesion energy is
-//! −β·Σ_b (ψ_b/ρ0) W_ib per particle, the attraction F_i = β Σ_b (ψ_b/ρ0) ∇W(x_i − x_b)
-//! (∇W(x_i − x_j) points from i towards j).
-//! A wall whose particles stand for the fluid it replaces (as their volumes ψ_b/ρ0 make them
-//! do for the density) holds a fluid half-space with Λ·β per unit area, so β = W/Λ makes
-//! the work of adhesion W (N/m) the energy per unit area of pulling the fluid off the wall;
-//! W = 2σ wets as the fluid wets itself.
+//! Adhesion is an energy of the fluid against the walls: −β·Σ_b (ψ_b/ρ0) W_ib per particle,
+//! the walls' share of its density, giving the attraction F_i = β Σ_b (ψ_b/ρ0) ∇W(x_i − x_b)
+//! (∇W(x_i − x_b) points from i towards b). A wall whose particles stand for the fluid it
+//! replaces (as their volumes ψ_b/ρ0 make them do for the density) holds a fluid half-space
+//! with Λ·β per unit area ([`lattice_pair_sum`]), so β = W/Λ makes the work of adhesion W
+//! (N/m) the energy per unit area of pulling the fluid off the wall.
 //!
-//! The forces change the velocities at the end of a step, Δv_i = Δt·F_i/m_i. Each particle's
-//! force is a gather over the step's neighbour lists in their fixed order, the same for any
-//! thread count; the lists are symmetric, so the cohesion conserves momentum.
+//! The forces change the velocities at the end of a step, Δv_i = Δt·F_i/m_i. Each
+//! particle's force is a gather over the step's neighbour lists in their fixed order, the
+//! same for any thread count.
 
 use super::{Forcing, NonPressureForce};
 use crate::Vec3;
@@ -41,8 +37,9 @@ use rayon::prelude::*;
 
 /// The pair sum Λ (1/m²) of the kernel `kernel` in the cubic lattice of spacing `spacing`
 /// (m), the fluid's rest packing: V·Σ W_ij over the pairs that straddle a plane, per unit
-/// area, averaged over the plane's orientation, V = d³ being a particle's volume. Splitting
-/// the lattice along that plane lowers Σ_i ρ_i/ρ0 by 2Λ per unit area.
+/// area, averaged over the plane's orientation, V = d³ being a particle's volume: what the
+/// particles on one side of the plane add to the filled volume fractions ρ_i/ρ0 of those on
+/// the other.
 ///
 /// A pair at offset o straddles a plane of normal n in (o·n)₊/d³ places per unit area, and
 /// (o·n)₊ averages |o|/4 over the directions of n; so Λ = Σ_{o≠0} |o|·W(|o|)/4. A drop's
@@ -67,15 +64,60 @@ pub(crate) fn lattice_pair_sum(kernel: &CubicKernel, spacing: f64) -> f64 {
     sum / 4.0
 }
 
-/// The cohesion and adhesion forces of a world's materials and walls.
+/// Normals are kept where |∇c|·H exceeds this (dimensionless): at the surface |∇c|·H is
+/// 0.3–1, inside the fluid it is the packing's noise, whose directions mean nothing.
+const NORMAL_THRESHOLD: f64 = 0.1;
+
+/// The share Γ of the colour's unit step that the particles' gradients sum to across a flat
+/// surface (dimensionless): Σ_k d·|∂c/∂z|(z_k) over the layers k of the rest lattice below
+/// a (100) face, c = V Σ_j W(x − x_j) the colour of the particles of volume V = d³.
+///
+/// The smoothed colour falls from 1 to 0 across the surface over the kernel's width, half
+/// of it beyond the last layer where no particle samples it, so Γ is about ½; dividing the
+/// surface force by Γ restores the whole jump (docs/method.md §16).
+pub(crate) fn captured_step(kernel: &CubicKernel, spacing: f64) -> f64 {
+    let reach = (kernel.support_radius() / spacing).ceil() as i32;
+    let volume = spacing.powi(3);
+    let mut sum = 0.0;
+    for layer in 0..=reach {
+        // ∂c/∂z at a particle `layer` layers below the face, from every site at or below it.
+        let mut slope = 0.0;
+        for i in -reach..=reach {
+            for j in -reach..=reach {
+                for k in 0..=reach + layer {
+                    if k - layer < -reach || k < layer - reach {
+                        continue;
+                    }
+                    // The site k layers below the face, at offset r = x_i − x_j.
+                    let r = Vec3::new(
+                        f64::from(i) * spacing,
+                        f64::from(j) * spacing,
+                        f64::from(k - layer) * spacing,
+                    );
+                    slope += volume * kernel.grad_w(&r).z;
+                }
+            }
+        }
+        sum += spacing * slope;
+    }
+    sum.abs()
+}
+
+/// Surface tension as a force on the surface (Brackbill, Kothe and Zemach 1992, in SPH after
+/// Morris 2000 and Adami, Hu and Adams 2010) and adhesion to walls, with their buffers.
 #[derive(Clone, Debug)]
 pub(crate) struct SurfaceTension {
-    /// Every material's cohesion coefficient s = σ/Λ (J), indexed by material.
-    cohesion: Vec<f64>,
+    /// Every material's surface tension σ over Γ ([`captured_step`]) (N/m), indexed by
+    /// material.
+    tension: Vec<f64>,
     /// The adhesion coefficient β = W/Λ (J).
     adhesion: f64,
     /// Every material's particle mass m_i (kg), indexed by material.
     masses: Vec<f64>,
+    /// Every particle's colour gradient ∇c_i (1/m).
+    gradients: Vec<Vec3>,
+    /// Every particle's outward unit normal, zero where |∇c| is below the threshold.
+    normals: Vec<Vec3>,
 }
 
 impl SurfaceTension {
@@ -84,57 +126,130 @@ impl SurfaceTension {
     pub fn new(params: &Params, materials: &Materials) -> Self {
         let kernel = CubicKernel::new(params.support_radius());
         let lambda = lattice_pair_sum(&kernel, params.spacing());
+        let captured = captured_step(&kernel, params.spacing());
         let mass = params.particle_mass();
         Self {
-            cohesion: materials
-                .tensions
-                .iter()
-                .map(|sigma| sigma / lambda)
-                .collect(),
+            tension: materials.tensions.iter().map(|s| s / captured).collect(),
             adhesion: params.wall_adhesion / lambda,
             masses: materials.mass_ratios.iter().map(|k| k * mass).collect(),
+            gradients: Vec::new(),
+            normals: Vec::new(),
         }
     }
+}
 
-    /// The force on fluid particle `i` (N) at positions `x` (m), particles of materials
-    /// `materials`.
+/// The colour gradient ∇c_i = Σ_j V ∇W(x_i − x_j) + Σ_b (ψ_b/ρ0) ∇W(x_i − x_b) (1/m) of
+/// fluid particle `i`: the walls count as fluid, so that only the free surface has one.
+#[inline]
+fn colour_gradient(f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
+    let (nb, kernel) = (f.nb, &f.constraint.kernel);
+    let volume = f.constraint.mass / f.constraint.rest_density;
+    let xi = x[i];
+    let fluid: Vec3 = nb
+        .fluid
+        .of(i)
+        .iter()
+        .map(|&j| kernel.grad_w(&(xi - x[j as usize])))
+        .sum();
+    let walls: Vec3 = nb
+        .boundary
+        .of(i)
+        .iter()
+        .map(|&b| {
+            let b = b as usize;
+            kernel.grad_w(&(xi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
+        })
+        .sum();
+    fluid * volume + walls / f.constraint.rest_density
+}
+
+/// The curvature κ_i = ∇·n̂ (1/m) at fluid particle `i` with outward normals `normals`:
+/// d·Σ_j V (n̂_j − n̂_i)·∇W_ij / Σ_j V |∇W_ij| |r_ij| over the neighbours that have a normal
+/// (Adami et al. 2010's normalisation, exact for a linear field of normals however few of
+/// the neighbours have one); 0 where none has.
+#[inline]
+fn curvature(f: &Forcing, x: &[Vec3], normals: &[Vec3], i: usize) -> f64 {
+    let kernel = &f.constraint.kernel;
+    let (xi, ni) = (x[i], normals[i]);
+    let (mut divergence, mut norm) = (0.0, 0.0);
+    for &j in f.nb.fluid.of(i) {
+        let j = j as usize;
+        let nj = normals[j];
+        if nj == Vec3::zeros() {
+            continue;
+        }
+        let r = xi - x[j];
+        let c = kernel.grad_w_coefficient(r.norm());
+        divergence += c * (nj - ni).dot(&r);
+        norm -= c * r.norm_squared();
+    }
+    if norm > 0.0 {
+        3.0 * divergence / norm
+    } else {
+        0.0
+    }
+}
+
+impl SurfaceTension {
+    /// The adhesion force on fluid particle `i` (N): β Σ_b (ψ_b/ρ0) ∇W(x_i − x_b).
     #[inline]
-    fn force(&self, f: &Forcing, x: &[Vec3], materials: &[u16], i: usize) -> Vec3 {
+    fn adhesion(&self, f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
         let (nb, kernel) = (f.nb, &f.constraint.kernel);
-        let volume = f.constraint.mass / f.constraint.rest_density;
-        let xi = x[i];
-        let si = self.cohesion[materials[i] as usize];
-        let mut pull = Vec3::zeros();
-        if si > 0.0 {
-            for &j in nb.fluid.of(i) {
-                let j = j as usize;
-                let sj = self.cohesion[materials[j] as usize];
-                let s = if si == sj { si } else { (si * sj).sqrt() };
-                pull += kernel.grad_w(&(xi - x[j])) * s;
-            }
-        }
-        let mut force = pull * (2.0 * volume);
-        if self.adhesion > 0.0 {
-            let beta = self.adhesion / f.constraint.rest_density;
-            for &b in nb.boundary.of(i) {
+        let beta = self.adhesion / f.constraint.rest_density;
+        let pull: Vec3 = nb
+            .boundary
+            .of(i)
+            .iter()
+            .map(|&b| {
                 let b = b as usize;
-                let r = xi - nb.boundary_positions.at(b);
-                force += kernel.grad_w(&r) * (beta * nb.boundary_psi[b]);
-            }
-        }
-        force
+                kernel.grad_w(&(x[i] - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
+            })
+            .sum();
+        pull * beta
     }
 }
 
 impl NonPressureForce for SurfaceTension {
+    fn try_reserve(&mut self, particles: usize) -> Result<(), std::collections::TryReserveError> {
+        crate::reserve::reserve_total(&mut self.gradients, particles)?;
+        crate::reserve::reserve_total(&mut self.normals, particles)
+    }
+
     fn apply(&mut self, f: &Forcing, fluid: &mut Fluid, scratch: &mut Vec<Vec3>) {
         let (x, v, materials) = (&fluid.positions, &fluid.velocities, &fluid.materials);
-        let dt = f.dt;
+        let n = x.len();
+        let threshold = NORMAL_THRESHOLD / f.constraint.kernel.support_radius();
+        self.gradients.clear();
+        self.gradients
+            .par_extend((0..n).into_par_iter().map(|i| colour_gradient(f, x, i)));
+        let gradients = &self.gradients;
+        self.normals.clear();
+        self.normals.par_extend(gradients.par_iter().map(|g| {
+            let length = g.norm();
+            if length > threshold {
+                -g / length
+            } else {
+                Vec3::zeros()
+            }
+        }));
+        let normals = &self.normals;
+        let volume = f.constraint.mass / f.constraint.rest_density;
+        let (dt, tension, masses) = (f.dt, &self.tension, &self.masses);
+        let adhesive = self.adhesion > 0.0;
         let this = &*self;
         scratch.clear();
-        scratch.par_extend((0..x.len()).into_par_iter().map(|i| {
-            let m = this.masses[materials[i] as usize];
-            v[i] + this.force(f, x, materials, i) * (dt / m)
+        scratch.par_extend((0..n).into_par_iter().map(|i| {
+            let material = materials[i] as usize;
+            let sigma = tension[material];
+            let mut force = Vec3::zeros();
+            if sigma > 0.0 && normals[i] != Vec3::zeros() {
+                // f = σκ∇c per unit volume, ∇c pointing into the fluid.
+                force += gradients[i] * (sigma * curvature(f, x, normals, i) * volume);
+            }
+            if adhesive {
+                force += this.adhesion(f, x, i);
+            }
+            v[i] + force * (dt / masses[material])
         }));
         std::mem::swap(&mut fluid.velocities, scratch);
     }
@@ -188,5 +303,15 @@ mod tests {
         // Λ scales as 1/d² at a fixed H/d.
         let half = lattice_pair_sum(&CubicKernel::new(1.0), 0.5);
         assert!((half / average - 4.0).abs() < 1e-12, "{half} {average}");
+    }
+
+    /// The particles below a flat surface sum to about half the colour's unit step, the
+    /// half inside the fluid; the share does not depend on the particle size.
+    #[test]
+    fn the_particles_capture_half_the_colour_step() {
+        let share = captured_step(&CubicKernel::new(2.0), 1.0);
+        assert!((share - 0.5).abs() < 0.1, "{share}");
+        let small = captured_step(&CubicKernel::new(0.02), 0.01);
+        assert!((small / share - 1.0).abs() < 1e-9, "{small} {share}");
     }
 }

@@ -5,11 +5,12 @@
 //! surface of curvature κ, spread over the kernel's width as the volume force
 //!
 //! ```text
-//! f = σ κ ∇c / Γ,     c_i = Σ_j V W_ij + Σ_b (ψ_b/ρ0) W_ib,     κ = ∇·n̂,  n̂ = −∇c/|∇c|
+//! f = σ κ ∇c / Γ,     c_i = Σ_j V W_ij,     κ = ∇·n̂,  n̂ = −∇c/|∇c|
 //! ```
 //!
-//! c being the colour of the fluid (1 inside, falling to 0 across the surface; the walls
-//! count as fluid, so only the free surface pulls). Without particles beyond the surface the
+//! c being the colour of the fluid (1 inside, falling to 0 across the surface). The walls
+//! are not fluid: where the fluid meets a wall it has a surface too, and the wall's
+//! adhesion, not the colour, decides how far it wets. Without particles beyond the surface the
 //! particles' gradients sum to a share Γ ≈ ½ of the colour's unit step: Γ is computed from
 //! the rest lattice when the world is made ([`captured_step`]), and dividing by it makes the
 //! force over the surface the whole σκ per unit area. Each particle has its material's σ;
@@ -138,8 +139,9 @@ impl SurfaceTension {
     }
 }
 
-/// The colour gradient ∇c_i = Σ_j V ∇W(x_i − x_j) + Σ_b (ψ_b/ρ0) ∇W(x_i − x_b) (1/m) of
-/// fluid particle `i`: the walls count as fluid, so that only the free surface has one.
+/// The colour gradient ∇c_i = Σ_j V ∇W(x_i − x_j) (1/m) of fluid particle `i`. Walls are
+/// not fluid: against a wall the fluid has a surface too, whose tension the wall's
+/// adhesion balances (Young and Dupré: without adhesion the fluid does not wet the wall).
 #[inline]
 fn colour_gradient(f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
     let (nb, kernel) = (f.nb, &f.constraint.kernel);
@@ -151,16 +153,7 @@ fn colour_gradient(f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
         .iter()
         .map(|&j| kernel.grad_w(&(xi - x[j as usize])))
         .sum();
-    let walls: Vec3 = nb
-        .boundary
-        .of(i)
-        .iter()
-        .map(|&b| {
-            let b = b as usize;
-            kernel.grad_w(&(xi - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
-        })
-        .sum();
-    fluid * volume + walls / f.constraint.rest_density
+    fluid * volume
 }
 
 /// The curvature κ_i = ∇·n̂ (1/m) at fluid particle `i` with outward normals `normals`:

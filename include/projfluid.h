@@ -969,10 +969,11 @@ enum PfStatus pf_world_get_material_kinematic_viscosity(const struct PfWorld *wo
 /**
  * Sets the surface tension σ (N/m) of `material` from the next step on: 0 leaves it
  * without surface tension (and costs nothing), water against air is 0.0728
- * (docs/method.md §16). Material 0 is the world's own fluid, whose
+ * (docs/method.md §17). Material 0 is the world's own fluid, whose
  * `PfParams.surface_tension` was its surface tension so far; other materials start without
- * one. Where two materials meet, their cohesion pairs with the geometric mean of theirs. A
- * world with surface tension limits its steps by the capillary rule (docs/method.md §8).
+ * one. Each particle at the fluid's free surface is pulled with its own material's σ; where
+ * two liquids meet there is no surface force. A world with surface tension limits its steps
+ * by the capillary rule (docs/method.md §8).
  *
  * Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
  * the world does not have, the message giving the valid range; a surface tension that is

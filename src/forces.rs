@@ -49,7 +49,7 @@ pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
 /// confinement and XSPH.
 pub(crate) fn of_world(params: &Params, materials: &Materials) -> Vec<Box<dyn NonPressureForce>> {
     let mut forces: Vec<Box<dyn NonPressureForce>> = Vec::new();
-    if materials.cohesive() || params.wall_adhesion > 0.0 {
+    if materials.tense() || params.wall_adhesion > 0.0 {
         forces.push(Box::new(SurfaceTension::new(params, materials)));
     }
     if materials.viscous() {

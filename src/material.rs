@@ -36,7 +36,7 @@ pub struct Material {
     /// Kinematic viscosity ν (m²/s) of the implicit viscosity solve (docs/method.md §13): 0
     /// leaves the liquid without physical viscosity; water is 1e-6, honey 1e-2 and more.
     pub kinematic_viscosity: f64,
-    /// Surface tension coefficient σ (N/m) of the cohesion force (docs/method.md §16): 0
+    /// Surface tension coefficient σ (N/m) of the surface force (docs/method.md §17): 0
     /// leaves the liquid without surface tension; water against air is 0.0728.
     pub surface_tension: f64,
 }
@@ -215,7 +215,7 @@ impl Materials {
     }
 
     /// Whether any material has a surface tension.
-    pub fn cohesive(&self) -> bool {
+    pub fn tense(&self) -> bool {
         self.tensions.iter().any(|&sigma| sigma > 0.0)
     }
 

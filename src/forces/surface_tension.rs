@@ -1,4 +1,4 @@
-//! Surface tension and adhesion to walls (docs/method.md §16).
+//! Surface tension and adhesion to walls (docs/method.md §17).
 //!
 //! Surface tension is the continuum surface force of Brackbill, Kothe and Zemach (1992) in
 //! its SPH form (Morris 2000; Adami, Hu and Adams 2010): the pressure jump σκ across a
@@ -75,7 +75,7 @@ const NORMAL_THRESHOLD: f64 = 0.1;
 ///
 /// The smoothed colour falls from 1 to 0 across the surface over the kernel's width, half
 /// of it beyond the last layer where no particle samples it, so Γ is about ½; dividing the
-/// surface force by Γ restores the whole jump (docs/method.md §16).
+/// surface force by Γ restores the whole jump (docs/method.md §17).
 pub(crate) fn captured_step(kernel: &CubicKernel, spacing: f64) -> f64 {
     let reach = (kernel.support_radius() / spacing).ceil() as i32;
     let volume = spacing.powi(3);

@@ -72,7 +72,7 @@ pub struct SceneMaterial {
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kinematic_viscosity: Option<f64>,
     /// Surface tension σ (N/m); absent or 0 leaves the liquid without surface tension
-    /// (docs/method.md §16).
+    /// (docs/method.md §17).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub surface_tension: Option<f64>,
 }

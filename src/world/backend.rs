@@ -150,7 +150,7 @@ impl World {
         if !self.boundary.walls.is_empty() {
             return refuse("container walls built as fields");
         }
-        if self.materials.cohesive() {
+        if self.materials.tense() {
             return refuse(SURFACE_TENSION);
         }
         if self.params.wall_adhesion > 0.0 {

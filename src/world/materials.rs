@@ -16,8 +16,8 @@ impl World {
     /// A material with a kinematic viscosity brings the implicit viscosity solve into the
     /// step (docs/method.md §13), on either backend.
     ///
-    /// A material with a surface tension brings the cohesion force into the step
-    /// (docs/method.md §16), which the GPU backend refuses.
+    /// A material with a surface tension brings the surface force into the step
+    /// (docs/method.md §17), which the GPU backend refuses.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
         if material.surface_tension > 0.0 {
             self.refuse_on_gpu(super::backend::SURFACE_TENSION)?;

@@ -94,10 +94,9 @@ pub const MAX_SURFACE_TENSION: f64 = 10.0;
 
 /// The factor c of the capillary limit Δt ≤ c·√(ρ d³/(2πσ)) on the step (docs/method.md
 /// §8), d being the particle spacing: Brackbill et al.'s bound with the particle spacing as
-/// the grid's. Its c is measured: at c = 0.2 a drop 8 or 10 particles across sheds
-/// particles, at c = 0.1 it holds together but its oscillation period (docs/validation.md)
-/// is still 9 % off the converged one, at c = 0.05 and below it is within the measurement's
-/// scatter of a few per cent.
+/// the grid's. Its c is measured on a drop 10 particles across (docs/validation.md): at
+/// c = 0.2 the drop loses its shape, at c = 0.1 its oscillation period is 9 % longer than
+/// at smaller steps, and from c = 0.05 down the period stays within a few per cent.
 pub const CAPILLARY_FACTOR: f64 = 0.05;
 
 /// Errors, naming the field, where `sigma` (N/m) is not a surface tension a material may

@@ -183,25 +183,6 @@ fn curvature(f: &Forcing, x: &[Vec3], normals: &[Vec3], i: usize) -> f64 {
     }
 }
 
-impl SurfaceTension {
-    /// The adhesion force on fluid particle `i` (N): β Σ_b (ψ_b/ρ0) ∇W(x_i − x_b).
-    #[inline]
-    fn adhesion(&self, f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
-        let (nb, kernel) = (f.nb, &f.constraint.kernel);
-        let beta = self.adhesion / f.constraint.rest_density;
-        let pull: Vec3 = nb
-            .boundary
-            .of(i)
-            .iter()
-            .map(|&b| {
-                let b = b as usize;
-                kernel.grad_w(&(x[i] - nb.boundary_positions.at(b))) * nb.boundary_psi[b]
-            })
-            .sum();
-        pull * beta
-    }
-}
-
 impl NonPressureForce for SurfaceTension {
     fn try_reserve(&mut self, particles: usize) -> Result<(), std::collections::TryReserveError> {
         crate::reserve::reserve_total(&mut self.gradients, particles)?;
@@ -228,8 +209,7 @@ impl NonPressureForce for SurfaceTension {
         let normals = &self.normals;
         let volume = f.constraint.mass / f.constraint.rest_density;
         let (dt, tension, masses) = (f.dt, &self.tension, &self.masses);
-        let adhesive = self.adhesion > 0.0;
-        let this = &*self;
+        let (adhesion, adhesive) = (self.adhesion, self.adhesion > 0.0);
         scratch.clear();
         scratch.par_extend((0..n).into_par_iter().map(|i| {
             let material = materials[i] as usize;
@@ -240,7 +220,8 @@ impl NonPressureForce for SurfaceTension {
                 force += gradients[i] * (sigma * curvature(f, x, normals, i) * volume);
             }
             if adhesive {
-                force += this.adhesion(f, x, i);
+                // β Σ_b (ψ_b/ρ0) ∇W(x_i − x_b), the walls built as fields included.
+                force += f.constraint.boundary_gradient(x[i], i, f.nb) * adhesion;
             }
             v[i] + force * (dt / masses[material])
         }));

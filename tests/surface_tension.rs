@@ -1,4 +1,4 @@
-//! Surface tension and wall adhesion (docs/method.md §16): what they change, what they
+//! Surface tension and wall adhesion (docs/method.md §17): what they change, what they
 //! conserve, and how bad values are refused.
 
 use projfluid::boundary::Aabb;

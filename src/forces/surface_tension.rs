@@ -85,10 +85,7 @@ pub(crate) fn captured_step(kernel: &CubicKernel, spacing: f64) -> f64 {
         let mut slope = 0.0;
         for i in -reach..=reach {
             for j in -reach..=reach {
-                for k in 0..=reach + layer {
-                    if k - layer < -reach || k < layer - reach {
-                        continue;
-                    }
+                for k in (layer - reach).max(0)..=layer + reach {
                     // The site k layers below the face, at offset r = x_i − x_j.
                     let r = Vec3::new(
                         f64::from(i) * spacing,
@@ -158,8 +155,9 @@ fn colour_gradient(f: &Forcing, x: &[Vec3], i: usize) -> Vec3 {
 
 /// The curvature κ_i = ∇·n̂ (1/m) at fluid particle `i` with outward normals `normals`:
 /// d·Σ_j V (n̂_j − n̂_i)·∇W_ij / Σ_j V |∇W_ij| |r_ij| over the neighbours that have a normal
-/// (Adami et al. 2010's normalisation, exact for a linear field of normals however few of
-/// the neighbours have one); 0 where none has.
+/// (Adami et al. 2010's normalisation, which rescales the sum for the neighbours without a
+/// normal; V cancels); 0 where none has. On a drop it reads on average more than 2/R, its
+/// surface being rough at the particles' scale (docs/method.md §17.1).
 #[inline]
 fn curvature(f: &Forcing, x: &[Vec3], normals: &[Vec3], i: usize) -> f64 {
     let kernel = &f.constraint.kernel;

@@ -155,8 +155,9 @@ pub struct PfParams {
     /// `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
     /// a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
     /// no world, where it cannot be had; `pf_params_validate` checks only the value. A world
-    /// on the GPU refuses bodies, walls built as fields and solvers other than
-    /// `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default `PF_BACKEND_CPU`.
+    /// on the GPU refuses bodies, walls built as fields, surface tension, wall adhesion and
+    /// solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default
+    /// `PF_BACKEND_CPU`.
     pub backend: u32,
     /// Vorticity confinement coefficient ε in [0, 10] (dimensionless; 0 = off): an
     /// acceleration ε·H·|ω|·(N × ω) that gives back rotation the solver and XSPH damp

@@ -165,8 +165,8 @@ class Params:
     backend: str = BACKENDS[_C_DEFAULTS.backend]
     """Where the world's steps run: ``"cpu"`` (the default, double precision) or ``"gpu"``
     (single precision on a Vulkan device, in a library built with the ``gpu`` feature). A
-    world on the GPU refuses bodies, walls built as fields, the physical viscosity and
-    solvers other than ``chebyshev`` and ``jacobi1``."""
+    world on the GPU refuses bodies, walls built as fields, surface tension, wall adhesion
+    and solvers other than ``chebyshev`` and ``jacobi1``."""
     vorticity_confinement: float = _C_DEFAULTS.vorticity_confinement
     """Vorticity confinement coefficient ε in [0, 10] (0 = off, the default): gives back
     rotation that the solver and XSPH damp; 0.1–1 is a useful range."""

@@ -32,7 +32,7 @@
  * Version of the binary interface this header describes; compare it with pf_abi_version()
  * at run time to detect a header/library mismatch.
  */
-#define PF_ABI_VERSION 6
+#define PF_ABI_VERSION 7
 
 /**
  * What a `pf_` function did. Every function that can fail returns one of these; on anything
@@ -214,8 +214,8 @@ typedef struct PfTransform {
  * `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
  * validates it. The struct is plain data owned by the caller; the library copies it.
  * Fields added in later versions are appended at its end (`kinematic_viscosity` and
- * `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6), and each
- * addition raises `PF_ABI_VERSION`.
+ * `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6,
+ * `surface_tension` and `wall_adhesion` in 7), and each addition raises `PF_ABI_VERSION`.
  */
 typedef struct PfParams {
     /**
@@ -351,8 +351,9 @@ typedef struct PfParams {
      * `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
      * a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
      * no world, where it cannot be had; `pf_params_validate` checks only the value. A world
-     * on the GPU refuses bodies, walls built as fields and solvers other than
-     * `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default `PF_BACKEND_CPU`.
+     * on the GPU refuses bodies, walls built as fields, surface tension, wall adhesion and
+     * solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default
+     * `PF_BACKEND_CPU`.
      */
     uint32_t backend;
     /**
@@ -361,6 +362,19 @@ typedef struct PfParams {
      * (docs/method.md §15); 0.1–1 is a useful range. Default 0.
      */
     double vorticity_confinement;
+    /**
+     * Surface tension σ (N/m) of the world's own fluid (material 0), finite and ≥ 0 (0 =
+     * off, costing nothing): water against air is 0.0728. Other materials have their own
+     * (`pf_world_set_material_surface_tension`). A world with surface tension limits its
+     * steps by the capillary rule (docs/method.md §8); the GPU backend refuses it. Default 0.
+     */
+    double surface_tension;
+    /**
+     * Work of adhesion W (N/m) between every fluid and the walls, static obstacles and
+     * bodies, finite and ≥ 0 (0 = off): with a fluid of surface tension σ the contact angle
+     * θ follows cos θ = W/σ − 1 (W = 2σ wets fully). The GPU backend refuses it. Default 0.
+     */
+    double wall_adhesion;
 } PfParams;
 
 /**
@@ -953,6 +967,44 @@ enum PfStatus pf_world_set_material_kinematic_viscosity(struct PfWorld *world,
 enum PfStatus pf_world_get_material_kinematic_viscosity(const struct PfWorld *world,
                                                         uint16_t material,
                                                         double *out);
+
+/**
+ * Sets the surface tension σ (N/m) of `material` from the next step on: 0 leaves it
+ * without surface tension (and costs nothing), water against air is 0.0728
+ * (docs/method.md §17). Material 0 is the world's own fluid, whose
+ * `PfParams.surface_tension` was its surface tension so far; other materials start without
+ * one. Each particle at the fluid's free surface is pulled with its own material's σ; where
+ * two liquids meet there is no surface force. A world with surface tension limits its steps
+ * by the capillary rule (docs/method.md §8).
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
+ * the world does not have, the message giving the valid range; a surface tension that is
+ * negative or not finite; a positive surface tension on a world that steps on the GPU,
+ * which does not support it yet, the message naming `surface_tension`). On any error
+ * nothing changes. Thread safety: one thread at a time per world.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`.
+ */
+enum PfStatus pf_world_set_material_surface_tension(struct PfWorld *world,
+                                                    uint16_t material,
+                                                    double surface_tension);
+
+/**
+ * Stores in `*out` the surface tension σ (N/m) of `material`: for material 0
+ * `PfParams.surface_tension` until `pf_world_set_material_surface_tension` sets it, for
+ * the others 0 until it does.
+ *
+ * Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+ * material the world does not have, the message giving the valid range); `*out` is then
+ * untouched.
+ *
+ * # Safety
+ * `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+ */
+enum PfStatus pf_world_get_material_surface_tension(const struct PfWorld *world,
+                                                    uint16_t material,
+                                                    double *out);
 
 /**
  * Copies every fluid particle's material id into `out`, in ascending id order, the order

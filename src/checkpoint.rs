@@ -102,6 +102,10 @@ pub fn write_checkpoint(
             .filter_map(|m| world.material(m as u16))
             .map(|m| m.kinematic_viscosity)
             .collect(),
+        tensions: (0..world.material_count())
+            .filter_map(|m| world.material(m as u16))
+            .map(|m| m.surface_tension)
+            .collect(),
         pressures: !state.pressures.is_empty(),
     };
     let json = serde_json::to_vec(&header)
@@ -298,6 +302,12 @@ pub fn read_checkpoint(path: &Path, threads: Option<usize>) -> Result<Checkpoint
         let id = u16::try_from(m).unwrap_or(u16::MAX);
         world
             .set_material_kinematic_viscosity(id, nu)
+            .map_err(|e| bad(&format!("holds an invalid material: {e}")))?;
+    }
+    for (m, &sigma) in header.tensions.iter().enumerate() {
+        let id = u16::try_from(m).unwrap_or(u16::MAX);
+        world
+            .set_material_surface_tension(id, sigma)
             .map_err(|e| bad(&format!("holds an invalid material: {e}")))?;
     }
     world

@@ -1,5 +1,5 @@
-//! Non-pressure forces: what acts on the fluid besides the density constraint (the physical
-//! viscosity, vorticity confinement and the XSPH filter). They change the velocities after a step's positions are
+//! Non-pressure forces: what acts on the fluid besides the density constraint (surface
+//! tension, the physical viscosity, vorticity confinement and the XSPH filter). They change the velocities after a step's positions are
 //! final (docs/method.md §1.3).
 
 use crate::Vec3;
@@ -8,10 +8,12 @@ use crate::constraint::{DensityConstraint, Neighborhood};
 use crate::fluid::Fluid;
 use crate::material::Materials;
 use crate::params::Params;
+use surface_tension::SurfaceTension;
 use viscosity::Viscosity;
 use vorticity::VorticityConfinement;
 use xsph::Xsph;
 
+mod surface_tension;
 pub(crate) mod viscosity;
 mod vorticity;
 mod xsph;
@@ -42,9 +44,14 @@ pub(crate) trait NonPressureForce: Send + Sync + std::fmt::Debug {
 }
 
 /// The non-pressure forces that `params` and the `materials` ask for, in the order they
-/// apply: the physical viscosity where any material has one.
+/// apply: surface tension and adhesion where any material has a surface tension or the
+/// walls an adhesion, the physical viscosity where any material has one, vorticity
+/// confinement and XSPH.
 pub(crate) fn of_world(params: &Params, materials: &Materials) -> Vec<Box<dyn NonPressureForce>> {
     let mut forces: Vec<Box<dyn NonPressureForce>> = Vec::new();
+    if materials.tense() || params.wall_adhesion > 0.0 {
+        forces.push(Box::new(SurfaceTension::new(params, materials)));
+    }
     if materials.viscous() {
         forces.push(Box::new(Viscosity::new(params.no_slip)));
     }

@@ -36,14 +36,19 @@ pub struct Material {
     /// Kinematic viscosity ν (m²/s) of the implicit viscosity solve (docs/method.md §13): 0
     /// leaves the liquid without physical viscosity; water is 1e-6, honey 1e-2 and more.
     pub kinematic_viscosity: f64,
+    /// Surface tension coefficient σ (N/m) of the surface force (docs/method.md §17): 0
+    /// leaves the liquid without surface tension; water against air is 0.0728.
+    pub surface_tension: f64,
 }
 
 impl Material {
-    /// A liquid of rest density `rest_density` (kg/m³) without physical viscosity.
+    /// A liquid of rest density `rest_density` (kg/m³) without physical viscosity or surface
+    /// tension.
     pub fn with_density(rest_density: f64) -> Self {
         Self {
             rest_density,
             kinematic_viscosity: 0.0,
+            surface_tension: 0.0,
         }
     }
 }
@@ -65,7 +70,8 @@ impl Material {
                 ),
             ));
         }
-        check_viscosity(self.kinematic_viscosity)
+        check_viscosity(self.kinematic_viscosity)?;
+        check_surface_tension(self.surface_tension)
     }
 }
 
@@ -82,6 +88,36 @@ pub(crate) fn check_viscosity(nu: f64) -> Result<(), Error> {
     ))
 }
 
+/// The largest surface tension a material may have (N/m): five times molten iron's. Above
+/// it the capillary limit on the step (docs/method.md §8) falls below any useful `dt_min`.
+pub const MAX_SURFACE_TENSION: f64 = 10.0;
+
+/// The factor c of the capillary limit Δt ≤ c·√(ρ d³/(2πσ)) on the step (docs/method.md
+/// §8), d being the particle spacing: Brackbill et al.'s bound with the particle spacing as
+/// the grid's. Its c is measured on a drop 10 particles across (docs/validation.md): at
+/// c = 0.2 the drop loses its shape, at c = 0.1 its oscillation period is 9 % longer than
+/// at smaller steps, and from c = 0.05 down the period stays within a few per cent.
+pub const CAPILLARY_FACTOR: f64 = 0.05;
+
+/// Errors, naming the field, where `sigma` (N/m) is not a surface tension a material may
+/// have: finite, not negative and at most [`MAX_SURFACE_TENSION`].
+pub(crate) fn check_surface_tension(sigma: f64) -> Result<(), Error> {
+    check_coefficient("surface_tension", sigma, MAX_SURFACE_TENSION)
+}
+
+/// Errors, naming `field`, where `value` (N/m) is not a coefficient of surface energy:
+/// finite, not negative and at most `most`.
+pub(crate) fn check_coefficient(field: &str, value: f64, most: f64) -> Result<(), Error> {
+    if value.is_finite() && (0.0..=most).contains(&value) {
+        return Ok(());
+    }
+    Err(Error::invalid(
+        field,
+        value,
+        &format!("must be finite and not negative, at most {most} (N/m; 0 turns it off)"),
+    ))
+}
+
 /// A world's materials beyond its own fluid, and the one that fluid added next is made of.
 #[derive(Clone, Debug)]
 pub(crate) struct Materials {
@@ -92,17 +128,21 @@ pub(crate) struct Materials {
     pub mass_ratios: Vec<f64>,
     /// Every material's kinematic viscosity ν (m²/s), indexed by material.
     pub viscosities: Vec<f64>,
+    /// Every material's surface tension σ (N/m), indexed by material.
+    pub tensions: Vec<f64>,
     /// The material of the fluid added next: blocks, particles, and the emitters added next.
     pub current: MaterialId,
 }
 
 impl Materials {
-    /// The materials of a world whose own fluid has kinematic viscosity `nu` (m²/s).
-    pub fn new(nu: f64) -> Self {
+    /// The materials of a world whose own fluid has kinematic viscosity `nu` (m²/s) and
+    /// surface tension `sigma` (N/m).
+    pub fn new(nu: f64, sigma: f64) -> Self {
         Self {
             added: Vec::new(),
             mass_ratios: vec![1.0],
             viscosities: vec![nu],
+            tensions: vec![sigma],
             current: 0,
         }
     }
@@ -124,6 +164,7 @@ impl Materials {
             0 => Some(Material {
                 rest_density: reference,
                 kinematic_viscosity: self.viscosities[0],
+                surface_tension: self.tensions[0],
             }),
             _ => self.added.get(id as usize - 1).copied(),
         }
@@ -143,6 +184,7 @@ impl Materials {
         self.added.push(material);
         self.mass_ratios.push(material.rest_density / reference);
         self.viscosities.push(material.kinematic_viscosity);
+        self.tensions.push(material.surface_tension);
         Ok((self.len() - 1) as MaterialId)
     }
 
@@ -156,6 +198,51 @@ impl Materials {
             self.added[m].kinematic_viscosity = nu;
         }
         Ok(())
+    }
+
+    /// Sets material `id`'s surface tension to `sigma` (N/m). Errors, changing nothing, on
+    /// an id the world has no material for or a surface tension [`check_surface_tension`]
+    /// rejects.
+    pub fn set_surface_tension(&mut self, id: MaterialId, sigma: f64) -> Result<(), Error> {
+        self.check_id("material", id)?;
+        check_surface_tension(sigma)?;
+        self.tensions[id as usize] = sigma;
+        if let Some(m) = (id as usize).checked_sub(1) {
+            self.added[m].surface_tension = sigma;
+        }
+        Ok(())
+    }
+
+    /// Whether any material has a surface tension.
+    pub fn tense(&self) -> bool {
+        self.tensions.iter().any(|&sigma| sigma > 0.0)
+    }
+
+    /// The capillary limit on the step size (s; docs/method.md §8): the shortest
+    /// [`CAPILLARY_FACTOR`]·√(ρ_i d³/(2π σ_i)) over the materials with a surface tension, ρ_i being the material's
+    /// rest density and d the particle spacing, the wall adhesion W counting as a surface
+    /// tension of the lightest material; Brackbill, Kothe and Zemach's (1992) bound on an
+    /// explicit surface tension, which the fastest capillary wave the particles resolve sets.
+    /// At least `dt_min`; infinite without surface tension or adhesion.
+    pub fn capillary_step(&self, params: &crate::Params) -> f64 {
+        let reference = params.rest_density;
+        let volume = params.spacing().powi(3);
+        let bound = |density: f64, sigma: f64| {
+            if sigma > 0.0 {
+                CAPILLARY_FACTOR * (density * volume / (2.0 * std::f64::consts::PI * sigma)).sqrt()
+            } else {
+                f64::INFINITY
+            }
+        };
+        let lightest = self
+            .mass_ratios
+            .iter()
+            .fold(f64::INFINITY, |a, &b| a.min(b));
+        let adhesion = bound(lightest * reference, params.wall_adhesion);
+        let step = (self.mass_ratios.iter().zip(&self.tensions))
+            .map(|(ratio, &sigma)| bound(ratio * reference, sigma))
+            .fold(adhesion, f64::min);
+        step.max(params.dt_min)
     }
 
     /// Whether any material has a physical viscosity.

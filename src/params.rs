@@ -265,6 +265,19 @@ pub struct Params {
     /// which [`crate::World::set_material_kinematic_viscosity`] may change later; other
     /// materials have their own ([`crate::Material::kinematic_viscosity`]).
     pub kinematic_viscosity: f64,
+    /// Surface tension coefficient σ (N/m) of the world's own fluid (material 0; docs/method.md
+    /// §17), at most [`crate::material::MAX_SURFACE_TENSION`]: 0, the default, leaves it out
+    /// and costs nothing; water against air is 0.0728.
+    /// [`crate::World::set_material_surface_tension`] may change it later; other materials
+    /// have their own ([`crate::Material::surface_tension`]). A world with surface tension
+    /// also limits its steps by the capillary rule (docs/method.md §8).
+    pub surface_tension: f64,
+    /// Work of adhesion W (N/m, energy per wetted area) between every fluid and the walls,
+    /// static obstacles and bodies (docs/method.md §17.2): 0, the default, leaves the
+    /// attraction out. With a fluid of surface tension σ, Young and Dupré's relation
+    /// cos θ = W/σ − 1 gives the contact angle θ it aims at: W = 2σ wets fully, W = σ
+    /// makes θ = 90°. At most twice [`crate::material::MAX_SURFACE_TENSION`].
+    pub wall_adhesion: f64,
     /// Vorticity confinement coefficient ε (dimensionless, docs/method.md §15): 0, the
     /// default, leaves it out; 0.1–1 gives back rotation that the iteration and XSPH damp.
     pub vorticity_confinement: f64,
@@ -382,6 +395,8 @@ impl Params {
             dt_initial: 1e-3,
             viscosity: 0.01,
             kinematic_viscosity: 0.0,
+            surface_tension: 0.0,
+            wall_adhesion: 0.0,
             vorticity_confinement: 0.0,
             no_slip: true,
             threads: 0,

@@ -543,11 +543,11 @@ impl Fuzzer {
                 }
                 22 => {
                     // Materials: add one (ordinary and bad densities), choose one (known or
-                    // not), set a viscosity (ordinary or bad), or read them back, per
-                    // material and per particle (short buffers).
+                    // not), set a viscosity or a surface tension (ordinary or bad), or read
+                    // them back, per material and per particle (short buffers).
                     let range = self.rng.pick(&[1usize, 2, 3, 8, 300]);
                     let material = self.rng.below(range) as u16;
-                    match self.rng.below(5) {
+                    match self.rng.below(6) {
                         0 => {
                             let rho = double(&mut self.rng, &[800.0, 1000.0, 1500.0, 3000.0]);
                             let mut id = u16::MAX;
@@ -598,6 +598,20 @@ impl Fuzzer {
                                 Moves::Nothing,
                                 0,
                             )
+                        }
+                        4 => {
+                            let sigma = double(&mut self.rng, &[0.0, 0.01, 0.0728]);
+                            let status = pf_world_set_material_surface_tension(w, material, sigma);
+                            // Read back only after a success: a read would replace the
+                            // message of a failure, which the harness checks.
+                            if status == PfStatus::PF_OK {
+                                let mut read = -7.0;
+                                let back =
+                                    pf_world_get_material_surface_tension(w, material, &mut read);
+                                assert_eq!(back, PfStatus::PF_OK);
+                                assert_eq!(read, sigma, "surface tension read back");
+                            }
+                            ("set_material_surface_tension", status, Moves::Nothing, 0)
                         }
                         _ => {
                             let valid = |m: u16| m < 0xabcd;

@@ -351,9 +351,10 @@ fn water_stepped_at_a_frame_rate_stays_in_its_container_on_the_gpu() {
     }
 }
 
-/// Worlds with what the GPU backend does not step yet (walls built as fields) are refused,
-/// naming it, and the world stays on the CPU; worlds with vorticity confinement, several
-/// materials or the physical viscosity, which it steps, are taken.
+/// Worlds with what the GPU backend does not step yet (walls built as fields, surface
+/// tension, wall adhesion) are refused, naming it, and the world stays on the CPU; worlds
+/// with vorticity confinement, several materials or the physical viscosity, which it steps,
+/// are taken.
 #[test]
 fn unsupported_worlds_are_refused_naming_the_feature() {
     let mut world = World::new(Params::default()).expect("parameters");
@@ -371,6 +372,35 @@ fn unsupported_worlds_are_refused_naming_the_feature() {
         "{message}"
     );
     assert_eq!(world.backend(), Backend::Cpu);
+    for (params, what) in [
+        (
+            Params {
+                surface_tension: 0.07,
+                ..Params::default()
+            },
+            "surface tension (surface_tension)",
+        ),
+        (
+            Params {
+                wall_adhesion: 0.1,
+                ..Params::default()
+            },
+            "the adhesion to walls (wall_adhesion)",
+        ),
+    ] {
+        let mut world = World::new(params.clone()).expect("parameters");
+        let message = world.set_backend(Backend::Gpu).unwrap_err().to_string();
+        assert_eq!(
+            message,
+            format!("backend gpu: does not support {what} yet; use the CPU backend")
+        );
+        assert_eq!(world.backend(), Backend::Cpu);
+        let on_gpu = Params {
+            backend: Backend::Gpu,
+            ..params
+        };
+        assert!(World::new(on_gpu).is_err());
+    }
     // Vorticity confinement, the physical viscosity and a second material are stepped there.
     let mut world = World::new(Params {
         vorticity_confinement: 0.3,
@@ -622,6 +652,18 @@ fn a_world_made_on_the_gpu_steps_as_one_switched_there() {
                 .err(),
             "the cg solver",
         ),
+        (
+            made.set_material_surface_tension(0, 0.07).err(),
+            "surface tension (surface_tension)",
+        ),
+        (
+            made.add_material(Material {
+                surface_tension: 0.03,
+                ..Material::with_density(800.0)
+            })
+            .err(),
+            "surface tension (surface_tension)",
+        ),
     ];
     for (error, what) in refusals {
         assert_eq!(
@@ -635,6 +677,7 @@ fn a_world_made_on_the_gpu_steps_as_one_switched_there() {
     assert_eq!(made.containers().len(), 1);
     assert_eq!(made.material_count(), 1);
     assert_eq!(made.params().solver, SolverKind::Chebyshev);
+    assert_eq!(made.params().surface_tension, 0.0);
     // A material is added to a world on the device as on the CPU, and the world steps on
     // there with its constants made again.
     let oil = made

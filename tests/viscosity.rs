@@ -178,6 +178,7 @@ fn a_material_viscosity_acts_as_the_parameter_does() {
     let water = Material {
         rest_density: 1000.0,
         kinematic_viscosity: nu,
+        surface_tension: 0.0,
     };
     let id = by_material.add_material(water).unwrap();
     by_material.set_fluid_material(id).unwrap();
@@ -239,6 +240,7 @@ fn material_viscosities_are_set_and_checked() {
     let bad = Material {
         rest_density: 1200.0,
         kinematic_viscosity: -1.0,
+        surface_tension: 0.0,
     };
     assert!(world.add_material(bad).is_err());
     assert_eq!(world.material_count(), 2);

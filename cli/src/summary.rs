@@ -33,6 +33,8 @@ pub struct RunSummary {
     pub no_slip: bool,
     /// Vorticity confinement ε (dimensionless; 0 = off).
     pub vorticity_confinement: f64,
+    /// Surface tension σ of the scene's own fluid (N/m; 0 = off).
+    pub surface_tension: f64,
     /// Worker threads.
     pub threads: usize,
     /// Fluid particles.
@@ -174,6 +176,7 @@ impl RunAccumulator {
             kinematic_viscosity: p.kinematic_viscosity,
             no_slip: p.no_slip,
             vorticity_confinement: p.vorticity_confinement,
+            surface_tension: p.surface_tension,
             threads: world.thread_count(),
             particles: world.fluid_count(),
             boundary_particles: world.boundary_count(),

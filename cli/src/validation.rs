@@ -1,9 +1,11 @@
 //! Validation against experiment and analytic solutions: the Martin & Moyce (1952) column
 //! collapse ([`martin_moyce`]), the MARIN dam break past a box (Kleefsman et al. 2005,
 //! [`kleefsman`]), a tank of water at rest ([`hydrostatic`]), viscous flow down a duct
-//! ([`poiseuille`]) and two liquids at rest and overturning ([`two_layers`]). The CLI's
+//! ([`poiseuille`]), two liquids at rest and overturning ([`two_layers`]) and a drop's
+//! capillary oscillation ([`droplet`]). The CLI's
 //! `projfluid validate` prints and plots what these modules compute; the tests assert on it.
 
+pub mod droplet;
 mod fit;
 pub mod hydrostatic;
 pub mod kleefsman;

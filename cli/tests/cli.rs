@@ -190,6 +190,7 @@ fn short_run_writes_stats_and_frames() {
         "kinematic_viscosity",
         "no_slip",
         "vorticity_confinement",
+        "surface_tension",
         "threads",
         "particles",
         "boundary_particles",
@@ -217,6 +218,7 @@ fn short_run_writes_stats_and_frames() {
     assert_eq!(json["kinematic_viscosity"], 0.0);
     assert_eq!(json["no_slip"], true);
     assert_eq!(json["vorticity_confinement"], 0.0);
+    assert_eq!(json["surface_tension"], 0.0);
     assert_eq!(json["nan"], 0);
 
     let mut names: Vec<String> = std::fs::read_dir(&frames)
@@ -742,6 +744,61 @@ fn kinematic_viscosity_and_no_slip_reach_the_run() {
     assert_eq!(held["no_slip"], true, "{held}");
     assert_ne!(held["positions_hash"], water["positions_hash"]);
     assert_ne!(held["positions_hash"], honey["positions_hash"]);
+    std::fs::remove_dir_all(&dir).unwrap();
+}
+
+/// `--surface-tension` replaces the scene's `surface_tension`, which the summary and the
+/// stats report and the run feels (another final state than without); a negative or too
+/// large one is refused naming the option, before any stats are written.
+#[test]
+fn surface_tension_reaches_the_run() {
+    let dir = temp_dir("surface-tension");
+    let stats = dir.join("stats.json");
+    let run = |extra: &[&str]| {
+        let mut args = vec![
+            "run",
+            "dam_break_small",
+            "--steps",
+            "3",
+            "--threads",
+            "1",
+            "--stats",
+            stats.to_str().unwrap(),
+        ];
+        args.extend_from_slice(extra);
+        projfluid(&args)
+    };
+    for value in ["-0.07", "11"] {
+        assert_bad_input(
+            &run(&["--surface-tension", value]),
+            &["--surface-tension must be finite and not negative", value],
+        );
+        assert!(!stats.exists(), "a refused run wrote {}", stats.display());
+    }
+    let hash = |extra: &[&str], summary: &str| {
+        let out = run(extra);
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(stdout.contains(summary), "{stdout}");
+        let json: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(&stats).unwrap()).unwrap();
+        (
+            json["surface_tension"].clone(),
+            json["positions_hash"].clone(),
+        )
+    };
+    let (plain, water) = hash(&[], "surface tension        off");
+    let (sigma, tense) = hash(
+        &["--surface-tension", "0.07"],
+        "surface tension        0.07 N/m",
+    );
+    assert_eq!((plain, sigma), (0.0.into(), 0.07.into()));
+    assert_ne!(water, tense);
     std::fs::remove_dir_all(&dir).unwrap();
 }
 

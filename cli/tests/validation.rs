@@ -6,7 +6,7 @@ mod support;
 use projfluid::SolverKind;
 use projfluid_lab::validation::martin_moyce::{self, ALIGNMENT_LEVEL, Comparison, Row, Setup};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, poiseuille, two_layers};
+use projfluid_lab::validation::{droplet, hydrostatic, poiseuille, two_layers};
 use std::path::PathBuf;
 use std::sync::OnceLock;
 use support::{projfluid, projfluid_ok};
@@ -223,6 +223,32 @@ fn duct_flow_takes_the_analytic_profile_at_two_viscosities() {
     }
 }
 
+/// A cube of water 8 particles across relaxes into a drop and, kicked into its n = 2 mode,
+/// oscillates with Rayleigh's period within 10 % at σ = 0.0182 and 0.0728 N/m
+/// (`projfluid validate droplet` at a coarse resolution): the period scales as 1/√σ.
+#[test]
+fn an_oscillating_drop_keeps_rayleighs_period_at_two_surface_tensions() {
+    let setup = droplet::Setup {
+        across: 8,
+        threads: 2,
+        ..droplet::Setup::default()
+    };
+    let report = droplet::simulate(&setup, |_| {}).unwrap();
+    assert_eq!(report.runs.len(), 2);
+    for run in &report.runs {
+        assert!(
+            run.error.abs() < 0.10,
+            "σ {} N/m: period {:.4} s against Rayleigh's {:.4} s ({:+.1} %)",
+            run.surface_tension,
+            run.period,
+            run.rayleigh,
+            100.0 * run.error
+        );
+    }
+    let ratio = report.runs[0].period / report.runs[1].period;
+    assert!((ratio / 2.0 - 1.0).abs() < 0.1, "period ratio {ratio}");
+}
+
 /// Two liquids (`projfluid validate two-layers`' defaults): oil of 800 kg/m³ over water at
 /// rest keeps its layers (within two spacings of the interface), each liquid reads its own
 /// density within 1 %, and the pressure follows the two-slope hydrostatic profile within 3 %
@@ -339,7 +365,7 @@ fn cli_martin_moyce_writes_its_table_csv_and_png() {
 fn cli_validate_rejects_bad_options_with_exit_code_2() {
     let dir = scratch("bad");
     let out_dir = dir.to_str().unwrap();
-    let cases: [&[&str]; 18] = [
+    let cases: [&[&str]; 20] = [
         &["validate", "martin-moyce", "--n2", "3", "--out", out_dir],
         &[
             "validate",
@@ -426,6 +452,15 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
         ],
         &[
             "validate",
+            "droplet",
+            "--surface-tension",
+            "0.07,-1",
+            "--out",
+            out_dir,
+        ],
+        &["validate", "droplet", "--resolution", "4", "--out", out_dir],
+        &[
+            "validate",
             "poiseuille",
             "--walls",
             "field",
@@ -470,6 +505,33 @@ fn cli_validate_rejects_bad_options_with_exit_code_2() {
         !dir.exists(),
         "a rejected command must not create its output directory"
     );
+}
+
+#[test]
+fn cli_droplet_writes_its_table_response_and_chart() {
+    let dir = scratch("cli_droplet");
+    let stdout = projfluid_ok(&[
+        "validate",
+        "droplet",
+        "--resolution",
+        "6",
+        "--surface-tension",
+        "0.0728",
+        "--threads",
+        "2",
+        "--out",
+        dir.to_str().unwrap(),
+    ]);
+    assert!(stdout.contains("oscillating drop"), "{stdout}");
+    assert!(stdout.contains("0.0728"), "{stdout}");
+    let csv = std::fs::read_to_string(dir.join("droplet_response.csv")).unwrap();
+    assert!(csv.lines().count() > 100, "{csv}");
+    assert!(
+        csv.lines().skip(1).all(|l| l.starts_with("0.0728,")),
+        "{csv}"
+    );
+    let png = std::fs::read(dir.join("droplet_response.png")).unwrap();
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
 }
 
 #[test]

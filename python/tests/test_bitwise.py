@@ -51,6 +51,7 @@ def test_a_world_built_in_python_matches_tests_c_bitwise_bit_for_bit(
     [
         ("fountain", 12),  # an emitter and a sink
         ("floating_boxes", 2),  # dynamic bodies
+        ("droplet", 5),  # surface tension
         (str(CHECKOUT / "scenes" / "dam_break_small.json"), 5),  # a scene file
     ],
 )

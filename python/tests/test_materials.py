@@ -161,6 +161,39 @@ def test_material_viscosity_is_set_read_and_checked(world: projfluid.World) -> N
         world.material_kinematic_viscosity(2)
 
 
+def test_material_surface_tension_is_set_read_and_checked(world: projfluid.World) -> None:
+    oil = world.add_material(800.0)
+    assert world.material_surface_tension(oil) == 0.0
+    assert world.material_surface_tension(0) == world.params.surface_tension == 0.0
+    world.set_material_surface_tension(oil, 0.03)
+    assert world.material_surface_tension(oil) == 0.03
+    for bad in (math.nan, -1e-3, math.inf, 11.0):
+        with pytest.raises(InvalidArgumentError) as raised:
+            world.set_material_surface_tension(oil, bad)
+        assert (
+            "pf_world_set_material_surface_tension: surface_tension must be finite"
+            in str(raised.value)
+        )
+        assert world.material_surface_tension(oil) == 0.03
+    with pytest.raises(InvalidArgumentError):
+        world.set_material_surface_tension(2, 0.03)
+    with pytest.raises(InvalidArgumentError):
+        world.material_surface_tension(2)
+
+
+def test_surface_tension_and_wall_adhesion_are_parameters() -> None:
+    params = small_params()
+    params.surface_tension = 0.05
+    params.wall_adhesion = 0.08
+    assert projfluid.Params.from_c(params.to_c()) == params
+    with projfluid.World(params) as world:
+        assert world.material_surface_tension(0) == 0.05
+    params.surface_tension = -1.0
+    with pytest.raises(InvalidArgumentError) as raised:
+        params.validate()
+    assert "surface_tension" in str(raised.value)
+
+
 def test_a_viscous_material_collapses_more_slowly(world: projfluid.World) -> None:
     """The fixture's column, with its material given ν = 0.5 m²/s, runs less than half as
     far in 0.3 s as the same column of water."""

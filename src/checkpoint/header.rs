@@ -45,6 +45,10 @@ pub(super) struct Header {
     /// none beyond the parameters' (`kinematic_viscosity`) for the world's own fluid.
     #[serde(default)]
     pub viscosities: Vec<f64>,
+    /// Every material's surface tension σ (N/m), the world's own fluid's first; absent in
+    /// checkpoints written before surface tension, whose materials had none.
+    #[serde(default)]
+    pub tensions: Vec<f64>,
     /// Whether the particle data holds the pressures the last step carried (absent, and no
     /// pressures, in checkpoints written before they were saved).
     #[serde(default)]

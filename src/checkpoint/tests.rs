@@ -136,7 +136,8 @@ fn a_resumed_world_keeps_its_physical_viscosity() {
     assert!(resumed.velocities() == reference.velocities());
 }
 
-/// Every particle's material and the world's materials, their viscosities too, travel with
+/// Every particle's material and the world's materials, their viscosities and surface
+/// tensions too, travel with
 /// the checkpoint: a resumed world of two liquids continues bit for bit; one whose particles
 /// all forgot their material does not.
 #[test]
@@ -147,9 +148,11 @@ fn a_resumed_world_keeps_its_materials() {
         .add_material(crate::Material {
             rest_density: 2500.0,
             kinematic_viscosity: 0.05,
+            surface_tension: 0.03,
         })
         .unwrap();
     reference.set_material_kinematic_viscosity(0, 1e-3).unwrap();
+    reference.set_material_surface_tension(0, 0.05).unwrap();
     reference.set_fluid_material(heavy).unwrap();
     reference
         .add_fluid_block(Vec3::new(0.05, 0.5, 0.05), [3, 3, 3], Vec3::zeros())

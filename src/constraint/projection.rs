@@ -148,8 +148,10 @@ impl DensityConstraint {
         grad_i * self.weight_of(nb, i) + members
     }
 
-    /// The boundary's and the walls' share of ∇_{x_i} C_i (1/m) for particle i at `pi`.
-    fn boundary_gradient(&self, pi: Vec3, i: usize, nb: &Neighborhood) -> Vec3 {
+    /// The boundary's and the walls' share of ∇_{x_i} C_i (1/m) for particle i at `pi`:
+    /// (Σ_b ψ_b ∇W(pi − x_b) + the walls built as fields) / ρ0. Wall adhesion pulls along it
+    /// (docs/method.md §17.2).
+    pub(crate) fn boundary_gradient(&self, pi: Vec3, i: usize, nb: &Neighborhood) -> Vec3 {
         let kernel = &self.kernel;
         (nb.boundary
             .of(i)

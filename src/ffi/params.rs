@@ -71,8 +71,8 @@ const _: () = assert!(size_of::<PfProjectionWeight>() == size_of::<c_int>());
 /// `pf_params_default`, change what you need, and pass it to `pf_world_create`, which
 /// validates it. The struct is plain data owned by the caller; the library copies it.
 /// Fields added in later versions are appended at its end (`kinematic_viscosity` and
-/// `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6), and each
-/// addition raises `PF_ABI_VERSION`.
+/// `no_slip` in ABI version 4, `backend` in 5, `vorticity_confinement` in 6,
+/// `surface_tension` and `wall_adhesion` in 7), and each addition raises `PF_ABI_VERSION`.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PfParams {
@@ -156,13 +156,23 @@ pub struct PfParams {
     /// `PF_BACKEND_GPU` (1; single precision, in a library built with the `gpu` feature, on
     /// a machine with a Vulkan adapter). `pf_world_create` opens the GPU and fails, making
     /// no world, where it cannot be had; `pf_params_validate` checks only the value. A world
-    /// on the GPU refuses bodies, walls built as fields and solvers other than
-    /// `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default `PF_BACKEND_CPU`.
+    /// on the GPU refuses bodies, walls built as fields, surface tension, wall adhesion and
+    /// solvers other than `PF_SOLVER_CHEBYSHEV` and `PF_SOLVER_JACOBI1`. Default
+    /// `PF_BACKEND_CPU`.
     pub backend: u32,
     /// Vorticity confinement coefficient ε in [0, 10] (dimensionless; 0 = off): an
     /// acceleration ε·H·|ω|·(N × ω) that gives back rotation the solver and XSPH damp
     /// (docs/method.md §15); 0.1–1 is a useful range. Default 0.
     pub vorticity_confinement: f64,
+    /// Surface tension σ (N/m) of the world's own fluid (material 0), finite and ≥ 0 (0 =
+    /// off, costing nothing): water against air is 0.0728. Other materials have their own
+    /// (`pf_world_set_material_surface_tension`). A world with surface tension limits its
+    /// steps by the capillary rule (docs/method.md §8); the GPU backend refuses it. Default 0.
+    pub surface_tension: f64,
+    /// Work of adhesion W (N/m) between every fluid and the walls, static obstacles and
+    /// bodies, finite and ≥ 0 (0 = off): with a fluid of surface tension σ the contact angle
+    /// θ follows cos θ = W/σ − 1 (W = 2σ wets fully). The GPU backend refuses it. Default 0.
+    pub wall_adhesion: f64,
 }
 
 impl From<&Params> for PfParams {
@@ -214,6 +224,8 @@ impl From<&Params> for PfParams {
                 Backend::Gpu => PfBackend::PF_BACKEND_GPU as u32,
             },
             vorticity_confinement: p.vorticity_confinement,
+            surface_tension: p.surface_tension,
+            wall_adhesion: p.wall_adhesion,
         }
     }
 }
@@ -317,6 +329,8 @@ pub(crate) unsafe fn read_params(raw: *const PfParams) -> Result<Params, Failure
         viscosity: field!(viscosity),
         kinematic_viscosity: field!(kinematic_viscosity),
         vorticity_confinement: field!(vorticity_confinement),
+        surface_tension: field!(surface_tension),
+        wall_adhesion: field!(wall_adhesion),
         no_slip,
         threads: count(field!(threads)),
         backend,

@@ -6,7 +6,7 @@ use std::ffi::c_char;
 /// Version of the binary interface; the header's `PF_ABI_VERSION` macro (in `cbindgen.toml`)
 /// must equal it, which `tests/header.rs` checks. Raised on every incompatible change of a
 /// function signature, struct layout or enum value.
-pub const PF_ABI_VERSION: u32 = 6;
+pub const PF_ABI_VERSION: u32 = 7;
 
 /// The library's version as a static NUL-terminated string, e.g. `"0.1.0"`. Never NULL; the
 /// string is owned by the library and never freed. Thread safe.

@@ -64,6 +64,9 @@ impl Params {
             ));
         }
         crate::material::check_viscosity(self.kinematic_viscosity)?;
+        crate::material::check_surface_tension(self.surface_tension)?;
+        let most = 2.0 * crate::material::MAX_SURFACE_TENSION;
+        crate::material::check_coefficient("wall_adhesion", self.wall_adhesion, most)?;
         if !(self.vorticity_confinement.is_finite()
             && (0.0..=MAX_VORTICITY_CONFINEMENT).contains(&self.vorticity_confinement))
         {

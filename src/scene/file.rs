@@ -54,6 +54,10 @@ struct SceneFile {
     time: Option<TimeFile>,
     viscosity: Option<f64>,
     kinematic_viscosity: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    surface_tension: Option<f64>,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    wall_adhesion: Option<f64>,
     vorticity_confinement: Option<f64>,
     no_slip: Option<bool>,
     threads: Option<usize>,
@@ -218,6 +222,8 @@ impl SceneFile {
         p.gravity = self.gravity.unwrap_or(p.gravity);
         set(&mut p.viscosity, self.viscosity);
         set(&mut p.kinematic_viscosity, self.kinematic_viscosity);
+        set(&mut p.surface_tension, self.surface_tension);
+        set(&mut p.wall_adhesion, self.wall_adhesion);
         set(&mut p.vorticity_confinement, self.vorticity_confinement);
         p.no_slip = self.no_slip.unwrap_or(p.no_slip);
         p.threads = self.threads.unwrap_or(p.threads);
@@ -353,6 +359,8 @@ impl SceneFile {
             }),
             viscosity: Some(p.viscosity),
             kinematic_viscosity: Some(p.kinematic_viscosity),
+            surface_tension: Some(p.surface_tension).filter(|&sigma| sigma > 0.0),
+            wall_adhesion: Some(p.wall_adhesion).filter(|&w| w > 0.0),
             vorticity_confinement: Some(p.vorticity_confinement),
             no_slip: Some(p.no_slip),
             threads: Some(p.threads),

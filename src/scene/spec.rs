@@ -71,6 +71,10 @@ pub struct SceneMaterial {
     /// liquid without physical viscosity (docs/method.md §13).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kinematic_viscosity: Option<f64>,
+    /// Surface tension σ (N/m); absent or 0 leaves the liquid without surface tension
+    /// (docs/method.md §17).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub surface_tension: Option<f64>,
 }
 
 impl SceneMaterial {
@@ -79,6 +83,7 @@ impl SceneMaterial {
         crate::Material {
             rest_density: self.rest_density,
             kinematic_viscosity: self.kinematic_viscosity.unwrap_or(0.0),
+            surface_tension: self.surface_tension.unwrap_or(0.0),
         }
     }
 }

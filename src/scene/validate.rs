@@ -425,6 +425,12 @@ mod tests {
         let built = viscous.build_world().unwrap();
         assert_eq!(built.material(1).unwrap().kinematic_viscosity, 0.1);
         assert_eq!(Scene::from_json(&viscous.to_json()).unwrap(), viscous);
+        let tense = r#"[{"name": "oil", "rest_density": 800, "surface_tension": 0.03}]"#;
+        let tense = Scene::from_json(&scene(tense, r#", "material": "oil""#)).unwrap();
+        let built = tense.build_world().unwrap();
+        assert_eq!(built.material(1).unwrap().surface_tension, 0.03);
+        assert_eq!(built.material(0).unwrap().surface_tension, 0.0);
+        assert_eq!(Scene::from_json(&tense.to_json()).unwrap(), tense);
         assert_eq!(world.particle_materials(), [[0; 8], [1; 8]].concat());
         assert_eq!(world.fluid_material(), 0);
         assert_eq!(Scene::from_json(&good.to_json()).unwrap(), good);
@@ -443,6 +449,11 @@ mod tests {
                 r#"[{"name": "oil", "rest_density": 800, "kinematic_viscosity": -1}]"#.into(),
                 "",
                 vec!["materials[0].kinematic_viscosity", "-1"],
+            ),
+            (
+                r#"[{"name": "oil", "rest_density": 800, "surface_tension": -0.1}]"#.into(),
+                "",
+                vec!["materials[0].surface_tension", "-0.1"],
             ),
             (
                 r#"[{"name": "", "rest_density": 800}]"#.into(),

@@ -57,6 +57,13 @@ fn unsupported(what: &str) -> Error {
     gpu_error(&format!("does not support {what} yet; use the CPU backend"))
 }
 
+/// How a refusal names surface tension, which the GPU backend does not step.
+pub(super) const SURFACE_TENSION: &str = "surface tension (surface_tension)";
+
+/// How a refusal names the adhesion to walls, which the GPU backend does not step.
+#[cfg(feature = "gpu")]
+pub(super) const WALL_ADHESION: &str = "the adhesion to walls (wall_adhesion)";
+
 /// Whether the GPU backend steps with the global solver `kind`.
 fn gpu_solver(kind: SolverKind) -> bool {
     matches!(kind, SolverKind::Chebyshev | SolverKind::Jacobi1)
@@ -142,6 +149,12 @@ impl World {
         }
         if !self.boundary.walls.is_empty() {
             return refuse("container walls built as fields");
+        }
+        if self.materials.tense() {
+            return refuse(SURFACE_TENSION);
+        }
+        if self.params.wall_adhesion > 0.0 {
+            return refuse(WALL_ADHESION);
         }
         Ok(())
     }

@@ -15,7 +15,13 @@ impl World {
     ///
     /// A material with a kinematic viscosity brings the implicit viscosity solve into the
     /// step (docs/method.md §13), on either backend.
+    ///
+    /// A material with a surface tension brings the surface force into the step
+    /// (docs/method.md §17), which the GPU backend refuses.
     pub fn add_material(&mut self, material: Material) -> Result<MaterialId, Error> {
+        if material.surface_tension > 0.0 {
+            self.refuse_on_gpu(super::backend::SURFACE_TENSION)?;
+        }
         let id = self.materials.add(material, self.params.rest_density)?;
         self.update_forces();
         Ok(id)
@@ -33,6 +39,27 @@ impl World {
         self.materials.set_viscosity(id, nu)?;
         if id == 0 {
             self.params.kinematic_viscosity = nu;
+        }
+        self.update_forces();
+        Ok(())
+    }
+
+    /// Sets the surface tension σ (N/m) of material `id` (0 is the world's own fluid, whose
+    /// [`crate::Params::surface_tension`] follows), from the next step on. Errors, changing
+    /// nothing, on an id the world has no material for, a surface tension that is negative or
+    /// not finite, or a surface tension on a world that steps on the GPU, which does not
+    /// support it yet.
+    pub fn set_material_surface_tension(
+        &mut self,
+        id: MaterialId,
+        sigma: f64,
+    ) -> Result<(), Error> {
+        if sigma > 0.0 {
+            self.refuse_on_gpu(super::backend::SURFACE_TENSION)?;
+        }
+        self.materials.set_surface_tension(id, sigma)?;
+        if id == 0 {
+            self.params.surface_tension = sigma;
         }
         self.update_forces();
         Ok(())

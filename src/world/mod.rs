@@ -125,7 +125,7 @@ impl World {
             },
             pool,
             fluid: Fluid::default(),
-            materials: Materials::new(params.kinematic_viscosity),
+            materials: Materials::new(params.kinematic_viscosity, params.surface_tension),
             boundary: Boundary::default(),
             containers: Vec::new(),
             obstacles: Vec::new(),
@@ -138,7 +138,10 @@ impl World {
             wall_load: Load::default(),
             solver: linear_solver(params.solver),
             chebyshev: Chebyshev::new(params.chebyshev),
-            forces: forces::of_world(&params, &Materials::new(params.kinematic_viscosity)),
+            forces: forces::of_world(
+                &params,
+                &Materials::new(params.kinematic_viscosity, params.surface_tension),
+            ),
             buffers: StepBuffers::default(),
             time: 0.0,
             next_dt: (params.dt_initial)
@@ -239,9 +242,12 @@ impl World {
         self.steps
     }
 
-    /// The time step (s) the next CFL-limited step will use.
+    /// The time step (s) the next CFL-limited step will use: the CFL rule's, at most the
+    /// capillary limit where the world has surface tension or wall adhesion
+    /// (docs/method.md §8).
     pub fn next_dt(&self) -> f64 {
         self.next_dt
+            .min(self.materials.capillary_step(&self.params))
     }
 
     /// Statistics of the last step, if any step was taken.

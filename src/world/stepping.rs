@@ -26,7 +26,7 @@ const BOUNDARY_SORT_BYTES: f64 = 128.0;
 impl World {
     /// Takes one step with the CFL-limited step size.
     pub fn step(&mut self) -> Result<&StepStats, Error> {
-        self.step_with_dt(self.next_dt)
+        self.step_with_dt(self.next_dt())
     }
 
     /// Takes one step of `dt` seconds (positive, finite, at most [`crate::params::MAX_STEP`]).
@@ -297,8 +297,9 @@ impl World {
         self.prepare_steps(seconds)?;
         let mut steps = 0;
         while !landed(self.time) {
-            // next_dt lies in [dt_min, dt_max] (the CFL rule clamps it), so dt is valid.
-            let dt = self.next_dt.min(end - self.time);
+            // next_dt lies in [dt_min, dt_max] (the CFL rule clamps it, the capillary limit
+            // is at least dt_min), so dt is valid.
+            let dt = self.next_dt().min(end - self.time);
             self.take_prepared_step(dt)?;
             after(self, dt)?;
             steps += 1;

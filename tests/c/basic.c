@@ -75,6 +75,16 @@ static void two_liquids(const PfParams *params, int steps) {
     OK(pf_world_set_material_kinematic_viscosity(world, heavy, 1e-3));
     OK(pf_world_get_material_kinematic_viscosity(world, heavy, &nu));
     CHECK(nu == 1e-3);
+    /* Materials start without surface tension; one is set, read back and taken off. */
+    double sigma = -1.0;
+    OK(pf_world_get_material_surface_tension(world, heavy, &sigma));
+    CHECK(sigma == 0.0);
+    OK(pf_world_set_material_surface_tension(world, heavy, 0.05));
+    OK(pf_world_get_material_surface_tension(world, heavy, &sigma));
+    CHECK(sigma == 0.05);
+    OK(pf_world_set_material_surface_tension(world, heavy, 0.0));
+    OK(pf_world_get_material_surface_tension(world, 0, &sigma));
+    CHECK(sigma == params->surface_tension);
 
     /* A 6 x 5 x 6 lattice one spacing and r/4 from the walls: its two bottom layers heavy,
      * the three above them water (material 0), added as particles (not settled, so the

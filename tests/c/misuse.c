@@ -388,6 +388,8 @@ int main(void) {
                pf_world_set_material_kinematic_viscosity(NULL, 0, 1e-3));
         REJECT(w, PF_ERROR_NULL_POINTER,
                pf_world_get_material_kinematic_viscosity(NULL, 0, &rho0));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_set_material_surface_tension(NULL, 0, 0.07));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_surface_tension(NULL, 0, &rho0));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(NULL, mats, 27, &needed));
         CHECK(strstr(last_msg, "world must not be NULL") != NULL);
         /* NULL outputs: a material is not added for want of a place to put its id. */
@@ -397,6 +399,7 @@ int main(void) {
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_material_count(w, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_rest_density(w, 0, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_kinematic_viscosity(w, 0, NULL));
+        REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_material_surface_tension(w, 0, NULL));
         REJECT(w, PF_ERROR_NULL_POINTER, pf_world_get_materials(w, NULL, 27, NULL));
         CHECK(strstr(last_msg, "out must not be NULL") != NULL);
         /* Rest densities that are not finite or lie outside 0.1 to 10 times the world's
@@ -430,6 +433,22 @@ int main(void) {
             CHECK(strstr(last_msg, "pf_world_set_material_kinematic_viscosity: "
                                    "kinematic_viscosity must be finite") != NULL);
         }
+        /* Surface tensions that are negative or not finite, or of an unknown material, the
+           argument named; the surface tension stays unset. */
+        const double bad_tensions[] = {NAN, INFINITY, -0.07};
+        for (size_t i = 0; i < sizeof bad_tensions / sizeof *bad_tensions; i++) {
+            REJECT(w, PF_ERROR_INVALID_ARGUMENT,
+                   pf_world_set_material_surface_tension(w, 1, bad_tensions[i]));
+            CHECK(strstr(last_msg, "pf_world_set_material_surface_tension: "
+                                   "surface_tension must be finite and not negative") != NULL);
+        }
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_set_material_surface_tension(w, 2, 0.07));
+        CHECK(strstr(last_msg, "material must name one of the world's 2 materials (0 to 1), "
+                               "got 2") != NULL);
+        REJECT(w, PF_ERROR_INVALID_ARGUMENT, pf_world_get_material_surface_tension(w, 2, &rho0));
+        double unset = -1.0;
+        OK(pf_world_get_material_surface_tension(w, 1, &unset));
+        CHECK(unset == 0.0);
         /* A short buffer: the size needed is reported and the buffer is left untouched. */
         for (size_t i = 0; i < sizeof mats / sizeof *mats; i++) mats[i] = 0xabcd;
         needed = 0;

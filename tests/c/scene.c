@@ -74,6 +74,20 @@ int main(int argc, char **argv) {
     CHECK(emitted > 0);
     pf_world_destroy(w);
 
+    /* The drop: 16^3 particles without gravity or walls, with water's surface tension,
+     * which pulls its corners in. */
+    OK(pf_world_create_from_scene("droplet", &w));
+    OK(pf_world_fluid_count(w, &fluid));
+    OK(pf_world_boundary_count(w, &boundary));
+    CHECK(fluid == 16 * 16 * 16 && boundary == 0);
+    OK(pf_world_get_params(w, &params));
+    CHECK(params.surface_tension == 0.0728 && params.gravity[1] == 0.0);
+    double sigma = 0.0;
+    OK(pf_world_get_material_surface_tension(w, 0, &sigma));
+    CHECK(sigma == 0.0728);
+    for (int i = 0; i < 5; i++) OK(pf_world_step(w, 0.0));
+    pf_world_destroy(w);
+
     printf("scene: ok %d\n", rejected);
     return 0;
 }

@@ -31,6 +31,7 @@ pub fn honey_beside_water(honey_nu: f64) -> (World, MaterialId) {
         .add_material(Material {
             rest_density: 1420.0,
             kinematic_viscosity: honey_nu,
+            surface_tension: 0.0,
         })
         .unwrap();
     world.set_fluid_material(honey).unwrap();

@@ -1,6 +1,6 @@
 """The C library: finding and loading it, mirrors of its structs, its functions' signatures.
 
-Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 6); the rest of the
+Everything here mirrors ``include/projfluid.h`` (``PF_ABI_VERSION`` 7); the rest of the
 package calls the C API only through :data:`lib`. ctypes releases the GIL during every
 foreign call, so long calls such as ``pf_world_advance`` let other Python threads run.
 """
@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any
 
 #: The binary interface these declarations were written for (``PF_ABI_VERSION``).
-ABI_VERSION = 6
+ABI_VERSION = 7
 
 
 def library_file_name() -> str:
@@ -82,6 +82,8 @@ class PfParams(ctypes.Structure):
         ("no_slip", c_uint32),
         ("backend", c_uint32),
         ("vorticity_confinement", c_double),
+        ("surface_tension", c_double),
+        ("wall_adhesion", c_double),
     ]
 
 
@@ -186,6 +188,8 @@ SIGNATURES: dict[str, tuple[list[Any], Any]] = {
     "pf_world_get_material_rest_density": ([_world, c_uint16, _doubles], _status),
     "pf_world_set_material_kinematic_viscosity": ([_world, c_uint16, c_double], _status),
     "pf_world_get_material_kinematic_viscosity": ([_world, c_uint16, _doubles], _status),
+    "pf_world_set_material_surface_tension": ([_world, c_uint16, c_double], _status),
+    "pf_world_get_material_surface_tension": ([_world, c_uint16, _doubles], _status),
     "pf_world_get_materials": ([_world, _u16s, c_size_t, _sizes], _status),
     # stepping
     "pf_world_step": ([_world, c_double], _status),

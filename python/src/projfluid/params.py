@@ -166,11 +166,19 @@ class Params:
     backend: str = BACKENDS[_C_DEFAULTS.backend]
     """Where the world's steps run: ``"cpu"`` (the default, double precision) or ``"gpu"``
     (single precision on a Vulkan device, in a library built with the ``gpu`` feature). A
-    world on the GPU refuses bodies, walls built as fields, the physical viscosity and
-    solvers other than ``chebyshev`` and ``jacobi1``."""
+    world on the GPU refuses bodies, walls built as fields, surface tension, wall adhesion
+    and solvers other than ``chebyshev`` and ``jacobi1``."""
     vorticity_confinement: float = _C_DEFAULTS.vorticity_confinement
     """Vorticity confinement coefficient ε in [0, 10] (0 = off, the default): gives back
     rotation that the solver and XSPH damp; 0.1–1 is a useful range."""
+    surface_tension: float = _C_DEFAULTS.surface_tension
+    """Surface tension σ (N/m) of the world's own fluid (material 0), finite and ≥ 0 (0 =
+    off, the default, costing nothing): water against air is 0.0728. A world with surface
+    tension limits its steps by the capillary rule; the GPU backend refuses it."""
+    wall_adhesion: float = _C_DEFAULTS.wall_adhesion
+    """Work of adhesion W (N/m) between every fluid and the walls, obstacles and bodies,
+    finite and ≥ 0 (0 = off, the default): with a fluid of surface tension σ the contact
+    angle θ follows cos θ = W/σ − 1 (W = 2σ wets fully). The GPU backend refuses it."""
 
     def __post_init__(self) -> None:
         for field in dataclasses.fields(self):

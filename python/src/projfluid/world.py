@@ -282,6 +282,26 @@ class World(BodiesMixin, FlowMixin):
         )
         return out.value
 
+    def set_material_surface_tension(self, material: int, surface_tension: float) -> None:
+        """Sets the surface tension σ (N/m) of ``material`` from the next step on: 0 leaves
+        it without surface tension, water against air is 0.0728. Material 0 is the world's
+        own fluid (its ``Params.surface_tension`` so far); the others start without one. An
+        unknown id, a negative or non-finite σ, one above 10 N/m, or a σ above 0 in a world
+        on the GPU raises :class:`~projfluid.errors.InvalidArgumentError` and changes
+        nothing."""
+        self._call(
+            lib.pf_world_set_material_surface_tension,
+            _material_id(material),
+            float(surface_tension),
+        )
+
+    def material_surface_tension(self, material: int) -> float:
+        """The surface tension σ (N/m) of ``material``. An id the world does not have raises
+        :class:`~projfluid.errors.InvalidArgumentError`."""
+        out = c_double()
+        self._call(lib.pf_world_get_material_surface_tension, _material_id(material), byref(out))
+        return out.value
+
     def materials(self, out: np.ndarray | None = None) -> np.ndarray:
         """Every fluid particle's material id as an (n,) uint16 array, in ascending id
         order like :meth:`positions`; ``out`` as in :meth:`positions`."""

@@ -199,6 +199,57 @@ pub unsafe extern "C" fn pf_world_get_material_kinematic_viscosity(
     unsafe { read_material(name, world, material, out, |m| m.kinematic_viscosity) }
 }
 
+/// Sets the surface tension σ (N/m) of `material` from the next step on: 0 leaves it
+/// without surface tension (and costs nothing), water against air is 0.0728
+/// (docs/method.md §17). Material 0 is the world's own fluid, whose
+/// `PfParams.surface_tension` was its surface tension so far; other materials start without
+/// one. Each particle at the fluid's free surface is pulled with its own material's σ; where
+/// two liquids meet there is no surface force. A world with surface tension limits its steps
+/// by the capillary rule (docs/method.md §8).
+///
+/// Errors: `PF_ERROR_NULL_POINTER` (world NULL), `PF_ERROR_INVALID_ARGUMENT` (a material
+/// the world does not have, the message giving the valid range; a surface tension that is
+/// negative or not finite; a positive surface tension on a world that steps on the GPU,
+/// which does not support it yet, the message naming `surface_tension`). On any error
+/// nothing changes. Thread safety: one thread at a time per world.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_set_material_surface_tension(
+    world: *mut PfWorld,
+    material: u16,
+    surface_tension: f64,
+) -> PfStatus {
+    // SAFETY: the caller keeps the contract above.
+    let args = unsafe { Args::trusted() };
+    status_call("pf_world_set_material_surface_tension", || {
+        let mut world = args.world(world)?;
+        Ok(world.set_material_surface_tension(material, surface_tension)?)
+    })
+}
+
+/// Stores in `*out` the surface tension σ (N/m) of `material`: for material 0
+/// `PfParams.surface_tension` until `pf_world_set_material_surface_tension` sets it, for
+/// the others 0 until it does.
+///
+/// Errors: `PF_ERROR_NULL_POINTER` (world or out NULL), `PF_ERROR_INVALID_ARGUMENT` (a
+/// material the world does not have, the message giving the valid range); `*out` is then
+/// untouched.
+///
+/// # Safety
+/// `world` must be NULL or a live handle from `pf_world_create`; `out` must be NULL or writable.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pf_world_get_material_surface_tension(
+    world: *const PfWorld,
+    material: u16,
+    out: *mut f64,
+) -> PfStatus {
+    let name = "pf_world_get_material_surface_tension";
+    // SAFETY: the caller keeps the contract above, which is read_material's.
+    unsafe { read_material(name, world, material, out, |m| m.surface_tension) }
+}
+
 /// Copies every fluid particle's material id into `out`, in ascending id order, the order
 /// of every other per-particle read (`pf_world_get_positions`, `pf_world_get_densities`,
 /// `pf_world_get_ids`, …). `capacity` is the length of `out` in ids; fluid count are needed

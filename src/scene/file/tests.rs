@@ -98,6 +98,37 @@ fn every_key_is_read() {
     assert_eq!(s.output.fps, Some(25.0));
 }
 
+/// `surface_tension` and `wall_adhesion` (N/m) are 0 unless a scene sets them, are written
+/// back only when set, and are checked naming the key.
+#[test]
+fn surface_tension_and_wall_adhesion_are_read_written_and_checked() {
+    let plain = Scene::from_json(GOOD).unwrap();
+    assert_eq!(
+        (plain.params.surface_tension, plain.params.wall_adhesion),
+        (0.0, 0.0)
+    );
+    assert!(!plain.to_json().contains("surface_tension"));
+    let text = GOOD.replacen(
+        "\"fluid_blocks\"",
+        "\"surface_tension\": 0.05, \"wall_adhesion\": 0.07, \"fluid_blocks\"",
+        1,
+    );
+    let scene = Scene::from_json(&text).unwrap();
+    assert_eq!(scene.params.surface_tension, 0.05);
+    assert_eq!(scene.params.wall_adhesion, 0.07);
+    let again = Scene::from_json(&scene.to_json()).unwrap();
+    assert_eq!(again, scene);
+    for (key, value) in [("surface_tension", "-0.05"), ("wall_adhesion", "1e9")] {
+        let bad = GOOD.replacen(
+            "\"fluid_blocks\"",
+            &format!("\"{key}\": {value}, \"fluid_blocks\""),
+            1,
+        );
+        let e = Scene::from_json(&bad).unwrap_err().to_string();
+        assert!(e.contains(key), "{e}");
+    }
+}
+
 #[test]
 fn round_trip_through_json() {
     let mut scenes: Vec<Scene> = Scene::builtin_names()

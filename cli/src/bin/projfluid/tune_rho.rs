@@ -65,6 +65,7 @@ pub(crate) fn tune_rho(args: &TuneRhoArgs) -> Result<(), Failure> {
         warm_start: None,
         coarse_correction: None,
         kinematic_viscosity: None,
+        surface_tension: None,
         vorticity_confinement: None,
         no_slip: None,
         threads: args.threads,

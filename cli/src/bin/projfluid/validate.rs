@@ -1,14 +1,17 @@
 //! `projfluid validate`: the Martin & Moyce dam break against the 1952 measurements, the
 //! MARIN dam break past a box against Kleefsman et al. (2005), a tank at rest against
 //! hydrostatics, viscous flow down a duct against its analytic profile, and two liquids at
-//! rest and overturning. Prints a table and writes CSV and PNG files.
+//! rest and overturning, and a drop's capillary oscillation against Rayleigh's period.
+//! Prints a table and writes CSV and PNG files.
 
 use crate::{Failure, on_off_parser, solver_parser};
 use clap::{Args, Subcommand};
 use projfluid::scene::ContainerWalls;
 use projfluid::{Error, SolverKind};
 use projfluid_lab::validation::reference::Measurements;
-use projfluid_lab::validation::{hydrostatic, kleefsman, martin_moyce, poiseuille, two_layers};
+use projfluid_lab::validation::{
+    droplet, hydrostatic, kleefsman, martin_moyce, poiseuille, two_layers,
+};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -30,6 +33,9 @@ pub(crate) enum ValidateCommand {
     /// Two liquids: a lighter one over water at rest (the pressure against the two-slope
     /// hydrostatic profile), and water over the lighter one, which overturns.
     TwoLayers(TwoLayersArgs),
+    /// A drop without gravity: a cube relaxes into a sphere under its surface tension, is
+    /// kicked into its n = 2 mode, and its period is compared with Rayleigh's, at each σ.
+    Droplet(DropletArgs),
 }
 
 /// Options every validation takes.
@@ -209,6 +215,25 @@ pub(crate) struct PoiseuilleArgs {
     common: CommonArgs,
 }
 
+/// Options of `projfluid validate droplet`.
+#[derive(Args)]
+pub(crate) struct DropletArgs {
+    /// Surface tensions to run, in N/m, comma-separated.
+    #[arg(
+        long,
+        value_name = "SIGMA,...",
+        default_value = "0.0182,0.0728",
+        value_delimiter = ',',
+        allow_negative_numbers = true
+    )]
+    surface_tension: Vec<f64>,
+    /// Particles along the edge of the cube the drop starts as (6–48).
+    #[arg(long, value_name = "N", default_value_t = 16)]
+    resolution: usize,
+    #[command(flatten)]
+    common: CommonArgs,
+}
+
 /// Options of `projfluid validate two-layers`.
 #[derive(Args)]
 pub(crate) struct TwoLayersArgs {
@@ -243,6 +268,7 @@ pub(crate) fn validate(command: &ValidateCommand) -> Result<(), Failure> {
         ValidateCommand::Hydrostatic(args) => hydrostatic(args),
         ValidateCommand::Poiseuille(args) => poiseuille(args),
         ValidateCommand::TwoLayers(args) => two_layers(args),
+        ValidateCommand::Droplet(args) => droplet(args),
     }
 }
 
@@ -503,6 +529,36 @@ fn two_layers(args: &TwoLayersArgs) -> Result<(), Failure> {
         files.pressure_png.display(),
         files.overturn_csv.display(),
         files.overturn_png.display()
+    );
+    print(&text)
+}
+
+fn droplet(args: &DropletArgs) -> Result<(), Failure> {
+    if args.common.walls() == ContainerWalls::Field {
+        return Err(Failure::Input(
+            "--walls field: the drop floats free, without walls; leave --walls out".into(),
+        ));
+    }
+    if args.common.solver != SolverKind::Chebyshev {
+        return Err(Failure::Input(
+            "--solver: the drop runs with the default solver, chebyshev".into(),
+        ));
+    }
+    let setup = droplet::Setup {
+        tensions: args.surface_tension.clone(),
+        across: args.resolution,
+        threads: args.common.threads,
+        ..droplet::Setup::default()
+    };
+    setup.validate().map_err(option_error)?;
+    create_dir(&args.common.out)?;
+    let report = droplet::simulate(&setup, |_| {}).map_err(runtime)?;
+    let files = droplet::write_report(&args.common.out, &report).map_err(runtime)?;
+    let text = format!(
+        "{}\nwrote {}, {}\n",
+        report.text(),
+        files.response_csv.display(),
+        files.response_png.display()
     );
     print(&text)
 }

@@ -33,6 +33,9 @@ pub(crate) struct ParamOptions {
     /// off; water 1e-6, honey 1e-2).
     #[arg(long, value_name = "NU", allow_negative_numbers = true)]
     pub(crate) kinematic_viscosity: Option<f64>,
+    /// Surface tension σ of the scene's own fluid, in N/m (0 turns it off; water 0.0728).
+    #[arg(long, value_name = "SIGMA", allow_negative_numbers = true)]
+    pub(crate) surface_tension: Option<f64>,
     /// Vorticity confinement ε in [0, 10], giving back rotation the solver and XSPH damp
     /// (0 turns it off; 0.1–1 is a useful range).
     #[arg(long, value_name = "EPSILON", allow_negative_numbers = true)]
@@ -68,6 +71,9 @@ impl ParamOptions {
         if let Some(nu) = self.kinematic_viscosity {
             p.kinematic_viscosity = nu;
         }
+        if let Some(sigma) = self.surface_tension {
+            p.surface_tension = sigma;
+        }
         if let Some(epsilon) = self.vorticity_confinement {
             p.vorticity_confinement = epsilon;
         }
@@ -80,7 +86,7 @@ impl ParamOptions {
     }
 
     /// Which scene key each option sets, and whether it was given.
-    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 9] {
+    pub(super) fn keys(&self) -> [(&'static str, &'static str, bool); 10] {
         [
             ("solver.rho", "--rho", self.rho.is_some()),
             ("solver.eta", "--eta", self.eta.is_some()),
@@ -99,6 +105,11 @@ impl ParamOptions {
                 "kinematic_viscosity",
                 "--kinematic-viscosity",
                 self.kinematic_viscosity.is_some(),
+            ),
+            (
+                "surface_tension",
+                "--surface-tension",
+                self.surface_tension.is_some(),
             ),
             (
                 "vorticity_confinement",

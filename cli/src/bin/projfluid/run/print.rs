@@ -44,6 +44,13 @@ pub(super) fn print_summary(s: &RunSummary) -> std::io::Result<()> {
                 "off".to_string()
             }
         }),
+        ("surface tension", {
+            if s.surface_tension > 0.0 {
+                format!("{} N/m", s.surface_tension)
+            } else {
+                "off".to_string()
+            }
+        }),
         ("threads", s.threads.to_string()),
         ("particles", s.particles.to_string()),
         ("boundary particles", s.boundary_particles.to_string()),

@@ -158,11 +158,9 @@ impl Extent {
     /// seen from the fluid: past the fluid along one axis and within its extent along the
     /// other two, as a wall through the cell is.
     fn faces_beyond(&self, b: &Vec3) -> u8 {
-        let within = |a: usize| b[a] >= self.min[a] && b[a] <= self.max[a];
         let mut faces = 0;
         for a in 0..3 {
-            let (e, f) = ((a + 1) % 3, (a + 2) % 3);
-            if within(e) && within(f) {
+            if self.in_front(b, a) {
                 if b[a] < self.min[a] {
                     faces |= 1 << (2 * a);
                 } else if b[a] > self.max[a] {
@@ -171,6 +169,13 @@ impl Extent {
             }
         }
         faces
+    }
+
+    /// Whether `b` (m) lies within the fluid's extent along the two axes other than `a`: in
+    /// front of the fluid seen along `a`.
+    fn in_front(&self, b: &Vec3, a: usize) -> bool {
+        let within = |i: usize| b[i] >= self.min[i] && b[i] <= self.max[i];
+        within((a + 1) % 3) && within((a + 2) % 3)
     }
 }
 
@@ -380,14 +385,11 @@ impl CoarseCorrection {
     fn close_faces_towards(&mut self, lattice: &Lattice, c: usize, b: &Vec3) {
         let (k, strides) = (lattice.coordinates(c), lattice.strides());
         for a in 0..3 {
-            let (e, f) = ((a + 1) % 3, (a + 2) % 3);
             // The neighbour below c along a sees c across its face towards +a, and so on.
             let below = (k[a] > 0).then(|| (c - strides[a], 2 * a + 1));
             let above = (k[a] + 1 < lattice.dims[a]).then(|| (c + strides[a], 2 * a));
             for (nb, face) in below.into_iter().chain(above) {
-                let extent = &self.extent[nb];
-                let within = |i: usize| b[i] >= extent.min[i] && b[i] <= extent.max[i];
-                if self.cells[nb] == Cell::Fluid && within(e) && within(f) {
+                if self.cells[nb] == Cell::Fluid && self.extent[nb].in_front(b, a) {
                     self.closed[nb] |= 1 << face;
                 }
             }
